@@ -1,0 +1,462 @@
+//! One Catmull-Clark step with Pixar's rules: the child topology and the stencils that compute
+//! every child vertex from parent vertices.
+//!
+//! Topology and stencils depend only on connectivity and sharpness, never on positions or
+//! colours, so they are computed once and any per-vertex data is refined by applying them.
+
+use crate::mesh::CreasingMethod;
+use crate::rules::{self, VertexRule};
+use crate::topology::{Topology, INVALID};
+use crate::validate::VertexData;
+
+/// One refinement level: topology plus the sharpness that drives the rules.
+#[derive(Clone, Debug)]
+pub struct Level {
+    /// Connectivity.
+    pub topology: Topology,
+    /// Sharpness per edge; boundary edges are infinitely sharp.
+    pub edge_sharpness: Vec<f64>,
+    /// Sharpness per vertex; corners are infinitely sharp.
+    pub vertex_sharpness: Vec<f64>,
+    /// How semi-sharp creases decay.
+    pub creasing: CreasingMethod,
+}
+
+impl Level {
+    /// The sharpness of the edges around `v`, in ring order.
+    pub fn incident_sharpness(&self, v: usize) -> Vec<f64> {
+        self.topology
+            .vertex_edges(v)
+            .iter()
+            .map(|&e| self.edge_sharpness[e as usize])
+            .collect()
+    }
+
+    /// The rule that applies at vertex `v` at this level.
+    pub fn vertex_rule(&self, v: usize) -> VertexRule {
+        let sharp = self
+            .topology
+            .vertex_edges(v)
+            .iter()
+            .filter(|&&e| rules::is_sharp(self.edge_sharpness[e as usize]))
+            .count();
+        rules::vertex_rule(self.vertex_sharpness[v], sharp)
+    }
+
+    /// Whether vertex `v` is regular: interior, valence 4, smooth, all faces quads.
+    pub fn is_regular_vertex(&self, v: usize) -> bool {
+        let t = &self.topology;
+        !t.is_boundary_vertex(v)
+            && t.vertex_edges(v).len() == 4
+            && self.vertex_rule(v) == VertexRule::Smooth
+            && t.vertex_faces(v)
+                .iter()
+                .all(|&f| t.face_vertices(f as usize).len() == 4)
+    }
+}
+
+/// Sparse weights: child vertex `i` is the sum of `weights[k] * parent[sources[k]]` over
+/// `k` in `offsets[i]..offsets[i + 1]`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Stencils {
+    offsets: Vec<u32>,
+    sources: Vec<u32>,
+    weights: Vec<f64>,
+}
+
+impl Stencils {
+    /// An empty table.
+    pub fn new() -> Self {
+        Stencils {
+            offsets: vec![0],
+            sources: Vec::new(),
+            weights: Vec::new(),
+        }
+    }
+
+    /// Appends one stencil, merging repeated sources and dropping zero weights.
+    pub fn push(&mut self, terms: &mut Vec<(u32, f64)>) {
+        terms.sort_unstable_by_key(|t| t.0);
+        let mut last = INVALID;
+        for &(s, w) in terms.iter() {
+            if s == last {
+                *self.weights.last_mut().expect("a previous term") += w;
+            } else {
+                self.sources.push(s);
+                self.weights.push(w);
+                last = s;
+            }
+        }
+        // Drop terms that cancelled or were zero.
+        let start = *self.offsets.last().expect("offsets start with 0") as usize;
+        let mut keep = start;
+        for k in start..self.sources.len() {
+            if self.weights[k] != 0.0 {
+                self.sources[keep] = self.sources[k];
+                self.weights[keep] = self.weights[k];
+                keep += 1;
+            }
+        }
+        self.sources.truncate(keep);
+        self.weights.truncate(keep);
+        self.offsets.push(keep as u32);
+        terms.clear();
+    }
+
+    /// Number of stencils (child vertices).
+    pub fn len(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// Whether the table is empty.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The sources and weights of stencil `i`.
+    pub fn stencil(&self, i: usize) -> (&[u32], &[f64]) {
+        let (s, e) = (self.offsets[i] as usize, self.offsets[i + 1] as usize);
+        (&self.sources[s..e], &self.weights[s..e])
+    }
+
+    /// Applies the stencils to parent data.
+    pub fn apply(&self, parent: &[VertexData]) -> Vec<VertexData> {
+        let mut out = vec![[0.0; 6]; self.len()];
+        self.apply_into(parent, &mut out);
+        out
+    }
+
+    /// Applies the stencils to parent data, writing into `out` (one entry per stencil).
+    pub fn apply_into(&self, parent: &[VertexData], out: &mut [VertexData]) {
+        for (i, o) in out.iter_mut().enumerate() {
+            let (src, w) = self.stencil(i);
+            let mut acc = [0.0; 6];
+            for (&s, &w) in src.iter().zip(w) {
+                let p = &parent[s as usize];
+                for c in 0..6 {
+                    acc[c] += w * p[c];
+                }
+            }
+            *o = acc;
+        }
+    }
+}
+
+/// Adds the terms of the centroid of face `f`, scaled by `scale`.
+fn face_centroid_terms(t: &Topology, f: usize, scale: f64, terms: &mut Vec<(u32, f64)>) {
+    let verts = t.face_vertices(f);
+    let w = scale / verts.len() as f64;
+    terms.extend(verts.iter().map(|&v| (v, w)));
+}
+
+/// Adds the terms of the vertex mask of `rule` at vertex `v`, scaled by `scale`. `sharp` tells
+/// which ring edges count as sharp for the crease mask.
+fn vertex_mask_terms(
+    parent: &Level,
+    v: usize,
+    rule: VertexRule,
+    sharp: &[bool],
+    scale: f64,
+    terms: &mut Vec<(u32, f64)>,
+) {
+    let t = &parent.topology;
+    match rule {
+        VertexRule::Corner => terms.push((v as u32, scale)),
+        VertexRule::Crease => {
+            terms.push((v as u32, 0.75 * scale));
+            for (k, &e) in t.vertex_edges(v).iter().enumerate() {
+                if sharp[k] {
+                    terms.push((t.other_vertex(e as usize, v as u32), 0.125 * scale));
+                }
+            }
+        }
+        VertexRule::Smooth | VertexRule::Dart => {
+            let edges = t.vertex_edges(v);
+            let n = edges.len() as f64;
+            terms.push((v as u32, scale * (n - 2.0) / n));
+            let w = scale / (n * n);
+            for &e in edges {
+                terms.push((t.other_vertex(e as usize, v as u32), w));
+            }
+            for &f in t.vertex_faces(v) {
+                face_centroid_terms(t, f as usize, w, terms);
+            }
+        }
+    }
+}
+
+/// Refines `parent` by one Catmull-Clark step.
+///
+/// Child vertices are numbered: one face point per parent face, then one edge point per parent
+/// edge, then one vertex point per parent vertex. Child face `c` is the quad at corner `c` of
+/// the flat parent corner list: `[vertex point, edge point of the outgoing edge, face point,
+/// edge point of the incoming edge]`, wound like its parent.
+pub fn refine(parent: &Level) -> (Level, Stencils) {
+    let t = &parent.topology;
+    let (nf, ne, nv) = (t.face_count(), t.edge_count(), t.vertex_count());
+    let face_point = |f: usize| f as u32;
+    let edge_point = |e: u32| (nf + e as usize) as u32;
+    let vertex_point = |v: u32| (nf + ne + v as usize) as u32;
+
+    // Child faces.
+    let corners = t.corner_count();
+    let mut offsets = Vec::with_capacity(corners + 1);
+    let mut verts = Vec::with_capacity(4 * corners);
+    offsets.push(0u32);
+    for f in 0..nf {
+        let fv = t.face_vertices(f);
+        let fe = t.face_edges(f);
+        let n = fv.len();
+        for i in 0..n {
+            verts.extend_from_slice(&[
+                vertex_point(fv[i]),
+                edge_point(fe[i]),
+                face_point(f),
+                edge_point(fe[(i + n - 1) % n]),
+            ]);
+            offsets.push(verts.len() as u32);
+        }
+    }
+    let child_topology = Topology::build(nf + ne + nv, offsets, verts, |_, _| false)
+        .expect("a refined manifold mesh is manifold");
+
+    // Child sharpness: vertex sharpness decays; each half of a parent edge gets the sharpness
+    // subdivided at its end vertex; edges inside parent faces are smooth.
+    let mut child_vertex_sharpness = vec![0.0; child_topology.vertex_count()];
+    for v in 0..nv {
+        child_vertex_sharpness[vertex_point(v as u32) as usize] =
+            rules::decrement_sharpness(parent.vertex_sharpness[v]);
+    }
+    let incident: Vec<Vec<f64>> = (0..nv).map(|v| parent.incident_sharpness(v)).collect();
+    let half_sharpness =
+        |e: u32, v: u32| -> f64 {
+            rules::child_edge_sharpness(
+                parent.creasing,
+                parent.edge_sharpness[e as usize],
+                &incident[v as usize],
+            )
+        };
+    let mut child_edge_sharpness = vec![0.0; child_topology.edge_count()];
+    for f in 0..nf {
+        let fv = t.face_vertices(f);
+        let fe = t.face_edges(f);
+        let n = fv.len();
+        let base = t.face_offset(f);
+        for i in 0..n {
+            let child_edges = child_topology.face_edges(base + i);
+            child_edge_sharpness[child_edges[0] as usize] = half_sharpness(fe[i], fv[i]);
+            child_edge_sharpness[child_edges[3] as usize] =
+                half_sharpness(fe[(i + n - 1) % n], fv[i]);
+        }
+    }
+    let child = Level {
+        topology: child_topology,
+        edge_sharpness: child_edge_sharpness,
+        vertex_sharpness: child_vertex_sharpness,
+        creasing: parent.creasing,
+    };
+
+    // Stencils.
+    let mut stencils = Stencils::new();
+    let mut terms = Vec::with_capacity(64);
+    for f in 0..nf {
+        face_centroid_terms(t, f, 1.0, &mut terms);
+        stencils.push(&mut terms);
+    }
+    for e in 0..ne {
+        let [a, b] = t.edge_vertices(e);
+        let s = parent.edge_sharpness[e];
+        let [f0, f1] = t.edge_faces(e);
+        // Crease weight: 1 for sharpness >= 1 or a boundary, fractional in between.
+        let crease = if f1 == INVALID { 1.0 } else { s.clamp(0.0, 1.0) };
+        terms.push((a, 0.5 * crease));
+        terms.push((b, 0.5 * crease));
+        if crease < 1.0 {
+            let smooth = 1.0 - crease;
+            terms.push((a, 0.25 * smooth));
+            terms.push((b, 0.25 * smooth));
+            face_centroid_terms(t, f0 as usize, 0.25 * smooth, &mut terms);
+            face_centroid_terms(t, f1 as usize, 0.25 * smooth, &mut terms);
+        }
+        stencils.push(&mut terms);
+    }
+    for v in 0..nv {
+        let cv = vertex_point(v as u32) as usize;
+        let parent_rule = parent.vertex_rule(v);
+        let child_rule = child.vertex_rule(cv);
+        let parent_sharp: Vec<bool> = incident[v].iter().map(|&s| rules::is_sharp(s)).collect();
+        if parent_rule == child_rule || parent_rule <= VertexRule::Dart {
+            vertex_mask_terms(parent, v, parent_rule, &parent_sharp, 1.0, &mut terms);
+        } else {
+            // The rule relaxes at this level: blend the two masks (Pixar's semi-sharp rule).
+            // Child ring edge k is the half of parent ring edge k at this vertex.
+            let child_incident: Vec<f64> = t
+                .vertex_edges(v)
+                .iter()
+                .map(|&e| half_sharpness(e, v as u32))
+                .collect();
+            let child_sharp: Vec<bool> =
+                child_incident.iter().map(|&s| rules::is_sharp(s)).collect();
+            let w = rules::fractional_weight(
+                parent.vertex_sharpness[v],
+                child.vertex_sharpness[cv],
+                &incident[v],
+                &child_incident,
+            );
+            vertex_mask_terms(parent, v, parent_rule, &parent_sharp, w, &mut terms);
+            vertex_mask_terms(parent, v, child_rule, &child_sharp, 1.0 - w, &mut terms);
+        }
+        stencils.push(&mut terms);
+    }
+    (child, stencils)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::SHARPNESS_INFINITE;
+
+    fn level(faces: &[Vec<u32>], nv: usize) -> Level {
+        let topology = Topology::from_faces(nv, faces).unwrap();
+        let edge_sharpness = (0..topology.edge_count())
+            .map(|e| {
+                if topology.is_boundary_edge(e) {
+                    SHARPNESS_INFINITE
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        Level {
+            vertex_sharpness: vec![0.0; nv],
+            topology,
+            edge_sharpness,
+            creasing: CreasingMethod::Uniform,
+        }
+    }
+
+    fn weights_of(st: &Stencils, i: usize) -> Vec<(u32, f64)> {
+        let (s, w) = st.stencil(i);
+        s.iter().copied().zip(w.iter().copied()).collect()
+    }
+
+    /// A closed star: valence-n vertex 0 in the middle of n quads, with the outer ring
+    /// closed off... here: an open fan of n quads around vertex 0, whose centre is interior.
+    fn quad_fan(n: u32) -> (Vec<Vec<u32>>, usize) {
+        // Vertex 0 centre; spokes 1..=n; diagonals n+1..=2n.
+        let faces = (0..n)
+            .map(|i| vec![0, 1 + i, n + 1 + i, 1 + (i + 1) % n])
+            .collect();
+        (faces, 1 + 2 * n as usize)
+    }
+
+    #[test]
+    fn smooth_vertex_mask_of_a_star() {
+        for n in 3..=7u32 {
+            let (faces, nv) = quad_fan(n);
+            let l = level(&faces, nv);
+            let (_, st) = refine(&l);
+            let (nf, ne) = (l.topology.face_count(), l.topology.edge_count());
+            let w = weights_of(&st, nf + ne);
+            let nn = n as f64;
+            // Centre: (n-2)/n + n * 1/n^2 * 1/4 (its share of every face centroid).
+            let centre = w.iter().find(|t| t.0 == 0).unwrap().1;
+            assert!((centre - ((nn - 2.0) / nn + 1.0 / (4.0 * nn))).abs() < 1e-12);
+            // Spoke: 1/n^2 as edge neighbour + 2 faces * 1/(4 n^2).
+            let spoke = w.iter().find(|t| t.0 == 1).unwrap().1;
+            assert!((spoke - 1.5 / (nn * nn)).abs() < 1e-12);
+            // Diagonal: one face * 1/(4 n^2).
+            let diag = w.iter().find(|t| t.0 == n + 1).unwrap().1;
+            assert!((diag - 0.25 / (nn * nn)).abs() < 1e-12);
+            let total: f64 = w.iter().map(|t| t.1).sum();
+            assert!((total - 1.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn crease_and_corner_masks() {
+        // Boundary vertex of a 2x1 strip: B-spline curve rule (1, 6, 1) / 8.
+        let faces = vec![vec![0, 1, 4, 3], vec![1, 2, 5, 4]];
+        let l = level(&faces, 6);
+        let (child, st) = refine(&l);
+        let (nf, ne) = (2, 7);
+        let w = weights_of(&st, nf + ne + 1);
+        assert_eq!(w, vec![(0, 0.125), (1, 0.75), (2, 0.125)]);
+        // Corner rule under edge-and-corner is decided by vertex sharpness: here none, so the
+        // single-face vertex 0 is a crease with its two boundary edges.
+        assert_eq!(l.vertex_rule(0), VertexRule::Crease);
+        let mut l2 = l.clone();
+        l2.vertex_sharpness[0] = SHARPNESS_INFINITE;
+        let (_, st2) = refine(&l2);
+        assert_eq!(weights_of(&st2, nf + ne), vec![(0, 1.0)]);
+        // Boundary edge point: midpoint.
+        let boundary_edge = (0..ne).find(|&e| l.topology.is_boundary_edge(e)).unwrap();
+        let [a, b] = l.topology.edge_vertices(boundary_edge);
+        let mut expect = vec![(a, 0.5), (b, 0.5)];
+        expect.sort_by_key(|t| t.0);
+        assert_eq!(weights_of(&st, nf + boundary_edge), expect);
+        assert!(child.topology.is_all_quads());
+        assert_eq!(
+            child.topology.euler_characteristic(),
+            l.topology.euler_characteristic()
+        );
+    }
+
+    #[test]
+    fn dart_uses_the_smooth_mask_and_semi_sharp_edges_blend() {
+        let (faces, nv) = quad_fan(5);
+        let mut l = level(&faces, nv);
+        let spoke = (0..l.topology.edge_count())
+            .find(|&e| {
+                let [a, b] = l.topology.edge_vertices(e);
+                (a.min(b), a.max(b)) == (0, 1)
+            })
+            .unwrap();
+        let smooth = refine(&l).1;
+        l.edge_sharpness[spoke] = SHARPNESS_INFINITE;
+        let (nf, ne) = (l.topology.face_count(), l.topology.edge_count());
+        let dart = refine(&l).1;
+        assert_eq!(l.vertex_rule(0), VertexRule::Dart);
+        assert_eq!(weights_of(&dart, nf + ne), weights_of(&smooth, nf + ne));
+        // A semi-sharp spoke of sharpness 0.25: its edge point blends midpoint and smooth rule.
+        l.edge_sharpness[spoke] = 0.25;
+        let semi = refine(&l).1;
+        let (s, w) = semi.stencil(nf + spoke);
+        let (s0, w0) = smooth.stencil(nf + spoke);
+        let weight = |src: &[u32], wt: &[f64], v: u32| {
+            src.iter().position(|&x| x == v).map_or(0.0, |k| wt[k])
+        };
+        let expect = 0.75 * weight(s0, w0, 0) + 0.25 * 0.5;
+        assert!((weight(s, w, 0) - expect).abs() < 1e-12);
+    }
+
+    #[test]
+    fn regular_grid_matches_uniform_bspline_refinement() {
+        // Interior vertex of a regular grid: (1/64) * [1 6 1; 6 36 6; 1 6 1].
+        let n = 4u32;
+        let mut faces = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let v = j * (n + 1) + i;
+                faces.push(vec![v, v + 1, v + n + 2, v + n + 1]);
+            }
+        }
+        let l = level(&faces, 25);
+        let (_, st) = refine(&l);
+        let (nf, ne) = (16, 40);
+        let centre = 12u32;
+        let w = weights_of(&st, nf + ne + centre as usize);
+        for (s, wt) in w {
+            let (dx, dy) = (
+                (s as i32 % 5 - 2).unsigned_abs(),
+                (s as i32 / 5 - 2).unsigned_abs(),
+            );
+            let f = |d: u32| match d {
+                0 => 6.0,
+                1 => 1.0,
+                _ => 0.0,
+            };
+            assert!((wt - f(dx) * f(dy) / 64.0).abs() < 1e-12, "{s}: {wt}");
+        }
+    }
+}

@@ -1,0 +1,174 @@
+//! Working colour spaces, conversion to and from sRGB, and CSS colour strings.
+
+use palette::{white_point::D65, FromColor, Lab, LinSrgb, Oklab};
+
+/// The space in which a mesh's colours are given and interpolated.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ColourSpace {
+    /// CIE L*a*b* with the D65 white point, L in 0..100 (the default, as in the paper).
+    #[default]
+    Lab,
+    /// Oklab, L in 0..1.
+    Oklab,
+    /// Linear-light sRGB, channels in 0..1.
+    SrgbLinear,
+    /// Non-linear (gamma-encoded) sRGB, channels in 0..1.
+    Srgb,
+}
+
+impl ColourSpace {
+    /// Every space, in the order of the documentation.
+    pub const ALL: [ColourSpace; 4] = [
+        ColourSpace::Lab,
+        ColourSpace::Oklab,
+        ColourSpace::SrgbLinear,
+        ColourSpace::Srgb,
+    ];
+
+    /// The name used in files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            ColourSpace::Lab => "lab",
+            ColourSpace::Oklab => "oklab",
+            ColourSpace::SrgbLinear => "srgb-linear",
+            ColourSpace::Srgb => "srgb",
+        }
+    }
+
+    /// The space with the given name.
+    pub fn from_name(name: &str) -> Option<ColourSpace> {
+        ColourSpace::ALL.into_iter().find(|s| s.name() == name)
+    }
+
+    /// Converts coordinates in this space to linear-light sRGB, without any gamut mapping: the
+    /// result may lie outside 0..1.
+    pub fn to_linear_srgb(self, c: [f64; 3]) -> [f64; 3] {
+        let lin: LinSrgb<f64> = match self {
+            ColourSpace::Lab => LinSrgb::from_color(Lab::<D65, f64>::new(c[0], c[1], c[2])),
+            ColourSpace::Oklab => LinSrgb::from_color(Oklab::<f64>::new(c[0], c[1], c[2])),
+            ColourSpace::SrgbLinear => return c,
+            ColourSpace::Srgb => {
+                return [
+                    srgb_decode(c[0]),
+                    srgb_decode(c[1]),
+                    srgb_decode(c[2]),
+                ]
+            }
+        };
+        [lin.red, lin.green, lin.blue]
+    }
+
+    /// Converts linear-light sRGB (any range) to coordinates in this space.
+    pub fn from_linear_srgb(self, rgb: [f64; 3]) -> [f64; 3] {
+        let lin = LinSrgb::<f64>::new(rgb[0], rgb[1], rgb[2]);
+        match self {
+            ColourSpace::Lab => {
+                let lab = Lab::<D65, f64>::from_color(lin);
+                [lab.l, lab.a, lab.b]
+            }
+            ColourSpace::Oklab => {
+                let ok = Oklab::<f64>::from_color(lin);
+                [ok.l, ok.a, ok.b]
+            }
+            ColourSpace::SrgbLinear => rgb,
+            ColourSpace::Srgb => [
+                srgb_encode(rgb[0]),
+                srgb_encode(rgb[1]),
+                srgb_encode(rgb[2]),
+            ],
+        }
+    }
+
+    /// Converts coordinates from `self` to `other`.
+    pub fn convert(self, other: ColourSpace, c: [f64; 3]) -> [f64; 3] {
+        if self == other {
+            c
+        } else {
+            other.from_linear_srgb(self.to_linear_srgb(c))
+        }
+    }
+
+    /// Whether the colour lies inside the sRGB gamut (with a small tolerance for rounding).
+    pub fn in_srgb_gamut(self, c: [f64; 3]) -> bool {
+        const TOLERANCE: f64 = 1e-4;
+        self.to_linear_srgb(c)
+            .iter()
+            .all(|&v| (-TOLERANCE..=1.0 + TOLERANCE).contains(&v))
+    }
+}
+
+/// The sRGB transfer function (encoding), extended to negative values by symmetry.
+pub fn srgb_encode(linear: f64) -> f64 {
+    let a = linear.abs();
+    let e = if a <= 0.003_130_8 {
+        12.92 * a
+    } else {
+        1.055 * a.powf(1.0 / 2.4) - 0.055
+    };
+    e.copysign(linear)
+}
+
+/// The inverse sRGB transfer function (decoding), extended to negative values by symmetry.
+pub fn srgb_decode(encoded: f64) -> f64 {
+    let a = encoded.abs();
+    let l = if a <= 0.040_45 {
+        a / 12.92
+    } else {
+        ((a + 0.055) / 1.055).powf(2.4)
+    };
+    l.copysign(encoded)
+}
+
+/// Parses a CSS Color 4 string (`#ff8800`, `rgb(...)`, `lab(...)`, `oklch(...)`, a named colour)
+/// into coordinates of `space` and an opacity.
+///
+/// CSS `lab()` is defined with the D50 white point; it is converted to this crate's D65 Lab like
+/// any other CSS colour.
+pub fn parse_css_colour(text: &str, space: ColourSpace) -> Result<([f64; 3], f64), String> {
+    let c = csscolorparser::parse(text).map_err(|e| e.to_string())?;
+    let [r, g, b, a] = c.to_linear_rgba();
+    let coords = space.from_linear_srgb([r as f64, g as f64, b as f64]);
+    Ok((coords, a as f64))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lab_white_is_srgb_white() {
+        let rgb = ColourSpace::Lab.to_linear_srgb([100.0, 0.0, 0.0]);
+        for v in rgb {
+            assert!((v - 1.0).abs() < 1e-3, "{rgb:?}");
+        }
+    }
+
+    #[test]
+    fn round_trips_through_linear_srgb() {
+        for space in ColourSpace::ALL {
+            let c = space.from_linear_srgb([0.2, 0.5, 0.7]);
+            let back = space.to_linear_srgb(c);
+            for (x, y) in back.iter().zip([0.2, 0.5, 0.7]) {
+                assert!((x - y).abs() < 1e-6, "{space:?}: {back:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn parses_css_strings() {
+        let (c, a) = parse_css_colour("#ff0000", ColourSpace::Srgb).unwrap();
+        assert!((c[0] - 1.0).abs() < 1e-6 && c[1].abs() < 1e-6 && c[2].abs() < 1e-6);
+        assert_eq!(a, 1.0);
+        let (lab, _) = parse_css_colour("white", ColourSpace::Lab).unwrap();
+        assert!((lab[0] - 100.0).abs() < 1e-2, "{lab:?}");
+        assert!(parse_css_colour("oklch(70% 0.1 200)", ColourSpace::Oklab).is_ok());
+        assert!(parse_css_colour("not a colour", ColourSpace::Lab).is_err());
+    }
+
+    #[test]
+    fn transfer_function_is_odd_and_invertible() {
+        for x in [-0.5, -0.001, 0.0, 0.002, 0.3, 1.0, 1.2] {
+            assert!((srgb_decode(srgb_encode(x)) - x).abs() < 1e-12);
+        }
+    }
+}

@@ -1,0 +1,153 @@
+//! The whole refinement: topology of every level built once, data evaluated on demand.
+//!
+//! Level 0 is the validated input (discontinuities split), level 1 the result of the ternary
+//! step, level `k` the ternary step followed by `k - 1` Catmull-Clark steps. Only the ternary
+//! step's positions depend non-linearly on the data (through the handles); every later level is
+//! a fixed linear map, so re-evaluating after an edit costs one pass over the stencils.
+
+use crate::catmull_clark::{self, Level, Stencils};
+use crate::error::{Error, Warning};
+use crate::limit;
+use crate::mesh::GradientMesh;
+use crate::ternary_step;
+use crate::topology::Topology;
+use crate::validate::{BaseMesh, VertexData};
+
+/// The topology of every level of a mesh's refinement, and the stencils between levels.
+#[derive(Clone, Debug)]
+pub struct Refinement {
+    base: BaseMesh,
+    /// `levels[k - 1]` is level `k`.
+    levels: Vec<Level>,
+    /// `stencils[k - 1]` computes level `k + 1` from level `k`.
+    stencils: Vec<Stencils>,
+}
+
+/// The data (positions, colours, opacity) of every level of a [`Refinement`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct RefinedMesh {
+    /// `levels[k]` holds the data of level `k`.
+    pub levels: Vec<Vec<VertexData>>,
+}
+
+impl Refinement {
+    /// Validates `mesh` and refines its topology down to level `depth`.
+    pub fn new(mesh: &GradientMesh, depth: usize) -> Result<(Refinement, Vec<Warning>), Error> {
+        let (base, warnings) = BaseMesh::new(mesh)?;
+        Ok((Refinement::from_base(base, depth), warnings))
+    }
+
+    /// Refines the topology of an already validated base level down to level `depth`.
+    pub fn from_base(base: BaseMesh, depth: usize) -> Refinement {
+        let mut r = Refinement {
+            base,
+            levels: Vec::new(),
+            stencils: Vec::new(),
+        };
+        r.extend_to(depth);
+        r
+    }
+
+    /// Refines further so that level `depth` exists.
+    pub fn extend_to(&mut self, depth: usize) {
+        if depth >= 1 && self.levels.is_empty() {
+            self.levels.push(ternary_step::ternary_level(&self.base));
+        }
+        while self.levels.len() < depth {
+            let (child, stencils) = catmull_clark::refine(self.levels.last().expect("level 1"));
+            self.levels.push(child);
+            self.stencils.push(stencils);
+        }
+    }
+
+    /// The deepest level built.
+    pub fn depth(&self) -> usize {
+        self.levels.len()
+    }
+
+    /// The validated base level.
+    pub fn base(&self) -> &BaseMesh {
+        &self.base
+    }
+
+    /// Level `k >= 1` (its topology and sharpness).
+    pub fn level(&self, k: usize) -> &Level {
+        &self.levels[k - 1]
+    }
+
+    /// The topology of level `k` (level 0 is the base).
+    pub fn topology(&self, k: usize) -> &Topology {
+        if k == 0 {
+            &self.base.topology
+        } else {
+            &self.levels[k - 1].topology
+        }
+    }
+
+    /// The stencils from level `k >= 1` to level `k + 1`.
+    pub fn stencils(&self, k: usize) -> &Stencils {
+        &self.stencils[k - 1]
+    }
+
+    /// Evaluates the data of every level from the base data.
+    pub fn evaluate(&self) -> RefinedMesh {
+        self.evaluate_with(&self.base)
+    }
+
+    /// Evaluates every level from other base data on the same topology (for example after an
+    /// edit of positions, colours or handles): no topology is rebuilt.
+    pub fn evaluate_with(&self, base: &BaseMesh) -> RefinedMesh {
+        let mut levels = vec![base.data.clone()];
+        if !self.levels.is_empty() {
+            levels.push(ternary_step::ternary_data(base));
+        }
+        for st in &self.stencils {
+            let next = st.apply(levels.last().expect("level 1"));
+            levels.push(next);
+        }
+        RefinedMesh { levels }
+    }
+
+    /// The limit position, colour and opacity of every vertex of level `k`, refining one or two
+    /// levels further where level `k` still has faces that are not quads.
+    pub fn limit(&mut self, data: &RefinedMesh, k: usize) -> Vec<VertexData> {
+        // Vertex v of level j has the vertex point nf + ne + v at level j + 1 (j >= 1), and
+        // vertex point v at level 1 (j = 0); both have the same limit.
+        let mut j = k;
+        let mut index: Vec<u32> = (0..self.topology(k).vertex_count() as u32).collect();
+        loop {
+            if j >= 1 {
+                if let Some(st) = limit::limit_stencils(self.level(j)) {
+                    let at_j = self.level_data(data, j);
+                    let all = st.apply(&at_j);
+                    return index.iter().map(|&i| all[i as usize]).collect();
+                }
+            }
+            if j >= 1 {
+                let t = self.topology(j);
+                let shift = (t.face_count() + t.edge_count()) as u32;
+                index.iter_mut().for_each(|i| *i += shift);
+            }
+            j += 1;
+            self.extend_to(j);
+        }
+    }
+
+    /// The data at level `j`, computing levels beyond those in `data` when needed.
+    fn level_data(&self, data: &RefinedMesh, j: usize) -> Vec<VertexData> {
+        if let Some(d) = data.levels.get(j) {
+            return d.clone();
+        }
+        let mut d = data.levels.last().expect("level 0").clone();
+        let mut at = data.levels.len() - 1;
+        if at == 0 {
+            d = ternary_step::ternary_data(&self.base);
+            at = 1;
+        }
+        while at < j {
+            d = self.stencils(at).apply(&d);
+            at += 1;
+        }
+        d
+    }
+}

@@ -1,0 +1,458 @@
+//! Flat topology of one refinement level: faces, edges and ordered vertex rings.
+//!
+//! Built once per level from face loops (structure of arrays, as OpenSubdiv's `Vtr::Level`),
+//! and checked for manifoldness and consistent winding on the way.
+
+use crate::error::ErrorKind;
+
+/// Marks a missing face or edge.
+pub const INVALID: u32 = u32::MAX;
+
+/// The connectivity of a polygon mesh with boundaries.
+#[derive(Clone, Debug, Default)]
+pub struct Topology {
+    vertex_count: usize,
+    face_offsets: Vec<u32>,
+    face_verts: Vec<u32>,
+    /// Edge from corner `i` to corner `i + 1` of each face, parallel to `face_verts`.
+    face_edges: Vec<u32>,
+    edge_verts: Vec<[u32; 2]>,
+    /// `[face running v0->v1, face running v1->v0]`; the second is `INVALID` on a boundary.
+    edge_faces: Vec<[u32; 2]>,
+    /// Ordered ring around each vertex: face `k` lies between ring edges `k` and `k + 1`.
+    ring_offsets: Vec<u32>,
+    ring_faces: Vec<u32>,
+    /// Corner index of the vertex inside each ring face, parallel to `ring_faces`.
+    ring_corners: Vec<u32>,
+    edge_ring_offsets: Vec<u32>,
+    ring_edges: Vec<u32>,
+}
+
+impl Topology {
+    /// Builds the topology of `faces` (a flat list of corner indices with `face_offsets`) over
+    /// `vertex_count` vertices. Half-edges for which `is_cut(face, corner)` holds are never
+    /// paired with a twin: both sides of a cut edge become boundaries.
+    ///
+    /// Fails on indices out of range, faces with fewer than three corners or a repeated corner,
+    /// edges shared by more than two faces or run twice in one direction, and vertices whose
+    /// faces do not form one fan. Error indices are face and vertex indices of this input.
+    pub fn build(
+        vertex_count: usize,
+        face_offsets: Vec<u32>,
+        face_verts: Vec<u32>,
+        is_cut: impl Fn(usize, usize) -> bool,
+    ) -> Result<Topology, ErrorKind> {
+        let face_count = face_offsets.len().saturating_sub(1);
+        for f in 0..face_count {
+            let corners = &face_verts[face_offsets[f] as usize..face_offsets[f + 1] as usize];
+            for (i, &v) in corners.iter().enumerate() {
+                if v as usize >= vertex_count {
+                    return Err(ErrorKind::IndexOutOfRange {
+                        face: f,
+                        corner: i,
+                        index: v as u64,
+                        count: vertex_count,
+                    });
+                }
+            }
+            if corners.len() < 3 {
+                return Err(ErrorKind::DegenerateFace {
+                    face: f,
+                    reason: format!("has {} corners, at least 3 are needed", corners.len()),
+                });
+            }
+            for (i, v) in corners.iter().enumerate() {
+                if corners[..i].contains(v) {
+                    return Err(ErrorKind::DegenerateFace {
+                        face: f,
+                        reason: format!("visits point {v} twice"),
+                    });
+                }
+            }
+        }
+
+        // Half-edge h is corner h of the flat corner list, running to the next corner.
+        let corner_count = face_verts.len();
+        let mut corner_face = vec![0u32; corner_count];
+        let mut next_corner = vec![0u32; corner_count];
+        let mut prev_corner = vec![0u32; corner_count];
+        for f in 0..face_count {
+            let (s, e) = (face_offsets[f], face_offsets[f + 1]);
+            for h in s..e {
+                corner_face[h as usize] = f as u32;
+                next_corner[h as usize] = if h + 1 == e { s } else { h + 1 };
+                prev_corner[h as usize] = if h == s { e - 1 } else { h - 1 };
+            }
+        }
+        let head = |h: usize| face_verts[next_corner[h] as usize];
+        let mut order: Vec<u32> = (0..corner_count as u32).collect();
+        let key = |h: u32| {
+            let (a, b) = (face_verts[h as usize], head(h as usize));
+            (a.min(b), a.max(b))
+        };
+        order.sort_unstable_by_key(|&h| (key(h), h));
+
+        let mut twin = vec![INVALID; corner_count];
+        let mut face_edges = vec![INVALID; corner_count];
+        let mut edge_verts = Vec::with_capacity(corner_count / 2 + 1);
+        let mut edge_faces = Vec::with_capacity(corner_count / 2 + 1);
+        let mut i = 0;
+        while i < order.len() {
+            let k = key(order[i]);
+            let mut j = i + 1;
+            while j < order.len() && key(order[j]) == k {
+                j += 1;
+            }
+            let group = &order[i..j];
+            let cut = |h: u32| {
+                let f = corner_face[h as usize] as usize;
+                is_cut(f, (h - face_offsets[f]) as usize)
+            };
+            let mut push_edge = |hs: &[u32]| {
+                let e = edge_verts.len() as u32;
+                let h0 = hs[0] as usize;
+                edge_verts.push([face_verts[h0], head(h0)]);
+                let f1 = hs.get(1).map_or(INVALID, |&h| corner_face[h as usize]);
+                edge_faces.push([corner_face[h0], f1]);
+                for &h in hs {
+                    face_edges[h as usize] = e;
+                }
+                if let [a, b] = hs {
+                    twin[*a as usize] = *b;
+                    twin[*b as usize] = *a;
+                }
+            };
+            if group.iter().any(|&h| cut(h)) {
+                for &h in group {
+                    push_edge(&[h]);
+                }
+            } else if group.len() == 1 {
+                push_edge(group);
+            } else if group.len() == 2 {
+                let (h0, h1) = (group[0] as usize, group[1] as usize);
+                if face_verts[h0] == face_verts[h1] {
+                    return Err(ErrorKind::InconsistentWinding {
+                        face_a: corner_face[h0] as usize,
+                        face_b: corner_face[h1] as usize,
+                        a: face_verts[h0],
+                        b: head(h0),
+                    });
+                }
+                push_edge(group);
+            } else {
+                let mut faces: Vec<usize> =
+                    group.iter().map(|&h| corner_face[h as usize] as usize).collect();
+                faces.sort_unstable();
+                return Err(ErrorKind::NonManifoldEdge {
+                    a: k.0,
+                    b: k.1,
+                    faces,
+                });
+            }
+            i = j;
+        }
+
+        // Corners of each vertex, then walk each vertex's fan.
+        let mut vert_corner_offsets = vec![0u32; vertex_count + 1];
+        for &v in &face_verts {
+            vert_corner_offsets[v as usize + 1] += 1;
+        }
+        for v in 0..vertex_count {
+            vert_corner_offsets[v + 1] += vert_corner_offsets[v];
+        }
+        let mut fill = vert_corner_offsets.clone();
+        let mut vert_corners = vec![0u32; corner_count];
+        for (h, &v) in face_verts.iter().enumerate() {
+            vert_corners[fill[v as usize] as usize] = h as u32;
+            fill[v as usize] += 1;
+        }
+
+        let mut ring_offsets = Vec::with_capacity(vertex_count + 1);
+        let mut ring_faces = Vec::with_capacity(corner_count);
+        let mut ring_corners = Vec::with_capacity(corner_count);
+        let mut edge_ring_offsets = Vec::with_capacity(vertex_count + 1);
+        let mut ring_edges = Vec::with_capacity(corner_count + vertex_count);
+        ring_offsets.push(0);
+        edge_ring_offsets.push(0);
+        for v in 0..vertex_count {
+            let corners = &vert_corners
+                [vert_corner_offsets[v] as usize..vert_corner_offsets[v + 1] as usize];
+            if let Some(&c0) = corners.first() {
+                // Walk backwards to the start of the fan: the corner whose incoming half-edge
+                // has no twin, or all the way round.
+                let mut start = c0;
+                loop {
+                    let t = twin[prev_corner[start as usize] as usize];
+                    if t == INVALID || t == c0 {
+                        break;
+                    }
+                    start = t;
+                }
+                let mut c = start;
+                let mut count = 0;
+                ring_edges.push(face_edges[prev_corner[c as usize] as usize]);
+                loop {
+                    let f = corner_face[c as usize];
+                    ring_faces.push(f);
+                    ring_corners.push(c - face_offsets[f as usize]);
+                    count += 1;
+                    let out = face_edges[c as usize];
+                    let t = twin[c as usize];
+                    if t == INVALID {
+                        ring_edges.push(out);
+                        break;
+                    }
+                    let next = next_corner[t as usize];
+                    if next == start {
+                        break;
+                    }
+                    ring_edges.push(out);
+                    c = next;
+                }
+                if count != corners.len() {
+                    return Err(ErrorKind::NonManifoldVertex {
+                        point: v as u32,
+                        fans: count_fans(corners, &twin, &prev_corner, &next_corner),
+                    });
+                }
+            }
+            ring_offsets.push(ring_faces.len() as u32);
+            edge_ring_offsets.push(ring_edges.len() as u32);
+        }
+
+        Ok(Topology {
+            vertex_count,
+            face_offsets,
+            face_verts,
+            face_edges,
+            edge_verts,
+            edge_faces,
+            ring_offsets,
+            ring_faces,
+            ring_corners,
+            edge_ring_offsets,
+            ring_edges,
+        })
+    }
+
+    /// Builds the topology of a list of face loops, with no cut edges.
+    pub fn from_faces(vertex_count: usize, faces: &[Vec<u32>]) -> Result<Topology, ErrorKind> {
+        let (offsets, verts) = flatten(faces);
+        Topology::build(vertex_count, offsets, verts, |_, _| false)
+    }
+
+    /// Number of vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.vertex_count
+    }
+
+    /// Number of faces.
+    pub fn face_count(&self) -> usize {
+        self.face_offsets.len().saturating_sub(1)
+    }
+
+    /// Number of edges.
+    pub fn edge_count(&self) -> usize {
+        self.edge_verts.len()
+    }
+
+    /// Total number of face corners.
+    pub fn corner_count(&self) -> usize {
+        self.face_verts.len()
+    }
+
+    /// The corners of face `f`, in winding order.
+    pub fn face_vertices(&self, f: usize) -> &[u32] {
+        &self.face_verts[self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize]
+    }
+
+    /// The edges of face `f`: edge `i` runs from corner `i` to corner `i + 1`.
+    pub fn face_edges(&self, f: usize) -> &[u32] {
+        &self.face_edges[self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize]
+    }
+
+    /// Offset of face `f`'s first corner in the flat corner list.
+    pub fn face_offset(&self, f: usize) -> usize {
+        self.face_offsets[f] as usize
+    }
+
+    /// The two end vertices of edge `e`.
+    pub fn edge_vertices(&self, e: usize) -> [u32; 2] {
+        self.edge_verts[e]
+    }
+
+    /// The faces on either side of edge `e` (`INVALID` for a missing side).
+    pub fn edge_faces(&self, e: usize) -> [u32; 2] {
+        self.edge_faces[e]
+    }
+
+    /// Whether edge `e` has a face on one side only.
+    pub fn is_boundary_edge(&self, e: usize) -> bool {
+        self.edge_faces[e][1] == INVALID
+    }
+
+    /// The faces around vertex `v`, in ring order.
+    pub fn vertex_faces(&self, v: usize) -> &[u32] {
+        &self.ring_faces[self.ring_offsets[v] as usize..self.ring_offsets[v + 1] as usize]
+    }
+
+    /// The corner of `v` in each of [`Topology::vertex_faces`].
+    pub fn vertex_face_corners(&self, v: usize) -> &[u32] {
+        &self.ring_corners[self.ring_offsets[v] as usize..self.ring_offsets[v + 1] as usize]
+    }
+
+    /// The edges around vertex `v`, in ring order; one more than the faces on a boundary.
+    pub fn vertex_edges(&self, v: usize) -> &[u32] {
+        &self.ring_edges
+            [self.edge_ring_offsets[v] as usize..self.edge_ring_offsets[v + 1] as usize]
+    }
+
+    /// Whether vertex `v` lies on a boundary (or has no face at all).
+    pub fn is_boundary_vertex(&self, v: usize) -> bool {
+        self.vertex_edges(v).len() != self.vertex_faces(v).len()
+    }
+
+    /// The vertex at the other end of edge `e` from `v`.
+    pub fn other_vertex(&self, e: usize, v: u32) -> u32 {
+        let [a, b] = self.edge_verts[e];
+        if a == v {
+            b
+        } else {
+            a
+        }
+    }
+
+    /// Euler characteristic V - E + F (counting only vertices used by faces).
+    pub fn euler_characteristic(&self) -> i64 {
+        let used = (0..self.vertex_count)
+            .filter(|&v| !self.vertex_faces(v).is_empty())
+            .count();
+        used as i64 - self.edge_count() as i64 + self.face_count() as i64
+    }
+
+    /// Whether every face is a quad.
+    pub fn is_all_quads(&self) -> bool {
+        (0..self.face_count()).all(|f| self.face_vertices(f).len() == 4)
+    }
+}
+
+/// Flattens face loops into offsets and corner indices.
+pub fn flatten(faces: &[Vec<u32>]) -> (Vec<u32>, Vec<u32>) {
+    let mut offsets = Vec::with_capacity(faces.len() + 1);
+    let mut verts = Vec::with_capacity(faces.iter().map(Vec::len).sum());
+    offsets.push(0);
+    for f in faces {
+        verts.extend_from_slice(f);
+        offsets.push(verts.len() as u32);
+    }
+    (offsets, verts)
+}
+
+/// Counts the fans among the corners of one vertex (for the error message only).
+fn count_fans(corners: &[u32], twin: &[u32], prev: &[u32], next: &[u32]) -> usize {
+    let mut seen = vec![false; corners.len()];
+    let index = |c: u32| corners.iter().position(|&x| x == c);
+    let mut fans = 0;
+    for i in 0..corners.len() {
+        if seen[i] {
+            continue;
+        }
+        fans += 1;
+        let mut stack = vec![corners[i]];
+        while let Some(c) = stack.pop() {
+            let Some(k) = index(c) else { continue };
+            if seen[k] {
+                continue;
+            }
+            seen[k] = true;
+            let t = twin[c as usize];
+            if t != INVALID {
+                stack.push(next[t as usize]);
+            }
+            let t = twin[prev[c as usize] as usize];
+            if t != INVALID {
+                stack.push(t);
+            }
+        }
+    }
+    fans
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid(n: u32) -> Vec<Vec<u32>> {
+        let mut faces = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let v = j * (n + 1) + i;
+                faces.push(vec![v, v + 1, v + n + 2, v + n + 1]);
+            }
+        }
+        faces
+    }
+
+    #[test]
+    fn grid_rings() {
+        let t = Topology::from_faces(16, &grid(3)).unwrap();
+        assert_eq!(t.edge_count(), 24);
+        assert_eq!(t.euler_characteristic(), 1);
+        // Interior vertex 5: four faces, four edges; corner vertex 0: one face, two edges.
+        assert_eq!(t.vertex_faces(5).len(), 4);
+        assert_eq!(t.vertex_edges(5).len(), 4);
+        assert!(!t.is_boundary_vertex(5));
+        assert_eq!(t.vertex_faces(0).len(), 1);
+        assert_eq!(t.vertex_edges(0).len(), 2);
+        assert!(t.is_boundary_vertex(0));
+        // Ring order: consecutive ring faces share the ring edge between them.
+        for v in 0..16 {
+            let faces = t.vertex_faces(v);
+            let edges = t.vertex_edges(v);
+            for (k, &f) in faces.iter().enumerate() {
+                let fe = t.face_edges(f as usize);
+                assert!(fe.contains(&edges[k]) && fe.contains(&edges[(k + 1) % edges.len()]));
+            }
+        }
+    }
+
+    #[test]
+    fn rejects_bad_meshes() {
+        let e = Topology::from_faces(4, &[vec![0, 1, 2], vec![0, 1, 3]]).unwrap_err();
+        assert!(matches!(e, ErrorKind::InconsistentWinding { a: 0, b: 1, .. }), "{e:?}");
+        let e = Topology::from_faces(5, &[vec![0, 1, 2], vec![1, 0, 3], vec![0, 1, 4]])
+            .unwrap_err();
+        assert!(matches!(e, ErrorKind::NonManifoldEdge { .. }), "{e:?}");
+        // Two triangles touching at a single point: a bow tie.
+        let e = Topology::from_faces(5, &[vec![0, 1, 2], vec![0, 3, 4]]).unwrap_err();
+        assert!(matches!(e, ErrorKind::NonManifoldVertex { point: 0, fans: 2 }), "{e:?}");
+        let e = Topology::from_faces(3, &[vec![0, 1]]).unwrap_err();
+        assert!(matches!(e, ErrorKind::DegenerateFace { face: 0, .. }), "{e:?}");
+        let e = Topology::from_faces(3, &[vec![0, 1, 7]]).unwrap_err();
+        assert!(matches!(e, ErrorKind::IndexOutOfRange { index: 7, .. }), "{e:?}");
+    }
+
+    #[test]
+    fn cut_edges_become_two_boundaries() {
+        // A 4x4 grid of quads; cut the interior edge 6-7 (both ends interior).
+        let faces = grid(4);
+        let (o, v) = flatten(&faces);
+        let t = Topology::build(25, o.clone(), v.clone(), |f, c| {
+            let corners = &v[o[f] as usize..o[f + 1] as usize];
+            let (a, b) = (corners[c], corners[(c + 1) % corners.len()]);
+            (a.min(b), a.max(b)) == (6, 7)
+        })
+        .unwrap();
+        assert_eq!(t.edge_count(), 41);
+        let cut: Vec<usize> = (0..41)
+            .filter(|&e| {
+                let [a, b] = t.edge_vertices(e);
+                (a.min(b), a.max(b)) == (6, 7)
+            })
+            .collect();
+        assert_eq!(cut.len(), 2);
+        assert!(cut.iter().all(|&e| t.is_boundary_edge(e)));
+        assert!(t.is_boundary_vertex(6) && t.is_boundary_vertex(7));
+        assert_eq!(t.vertex_edges(6).len(), 5);
+    }
+}
