@@ -228,14 +228,13 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
             rules::decrement_sharpness(parent.vertex_sharpness[v]);
     }
     let incident: Vec<Vec<f64>> = (0..nv).map(|v| parent.incident_sharpness(v)).collect();
-    let half_sharpness =
-        |e: u32, v: u32| -> f64 {
-            rules::child_edge_sharpness(
-                parent.creasing,
-                parent.edge_sharpness[e as usize],
-                &incident[v as usize],
-            )
-        };
+    let half_sharpness = |e: u32, v: u32| -> f64 {
+        rules::child_edge_sharpness(
+            parent.creasing,
+            parent.edge_sharpness[e as usize],
+            &incident[v as usize],
+        )
+    };
     let mut child_edge_sharpness = vec![0.0; child_topology.edge_count()];
     for f in 0..nf {
         let fv = t.face_vertices(f);
@@ -268,7 +267,11 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
         let s = parent.edge_sharpness[e];
         let [f0, f1] = t.edge_faces(e);
         // Crease weight: 1 for sharpness >= 1 or a boundary, fractional in between.
-        let crease = if f1 == INVALID { 1.0 } else { s.clamp(0.0, 1.0) };
+        let crease = if f1 == INVALID {
+            1.0
+        } else {
+            s.clamp(0.0, 1.0)
+        };
         terms.push((a, 0.5 * crease));
         terms.push((b, 0.5 * crease));
         if crease < 1.0 {

@@ -47,13 +47,7 @@ impl ColourSpace {
             ColourSpace::Lab => LinSrgb::from_color(Lab::<D65, f64>::new(c[0], c[1], c[2])),
             ColourSpace::Oklab => LinSrgb::from_color(Oklab::<f64>::new(c[0], c[1], c[2])),
             ColourSpace::SrgbLinear => return c,
-            ColourSpace::Srgb => {
-                return [
-                    srgb_decode(c[0]),
-                    srgb_decode(c[1]),
-                    srgb_decode(c[2]),
-                ]
-            }
+            ColourSpace::Srgb => return [srgb_decode(c[0]), srgb_decode(c[1]), srgb_decode(c[2])],
         };
         [lin.red, lin.green, lin.blue]
     }

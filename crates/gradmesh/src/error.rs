@@ -74,7 +74,9 @@ pub enum ErrorKind {
         value: String,
     },
     /// A face refers to a point that does not exist.
-    #[error("face {face}: corner {corner} refers to point {index}, but there are only {count} points")]
+    #[error(
+        "face {face}: corner {corner} refers to point {index}, but there are only {count} points"
+    )]
     IndexOutOfRange {
         /// Face index.
         face: usize,

@@ -17,6 +17,7 @@ pub mod formats;
 pub mod limit;
 pub mod mesh;
 pub mod refine;
+pub mod render;
 pub mod rules;
 pub mod ternary_step;
 pub mod topology;
@@ -25,9 +26,9 @@ pub mod validate;
 pub use colour::ColourSpace;
 pub use error::{Error, ErrorKind, Location, Result, Warning};
 pub use mesh::{
-    BoundaryInterpolation, ControlPoint, CreasingMethod, Document, EdgeKind, EdgeTag,
-    GradientMesh, WedgeOverride,
+    BoundaryInterpolation, ControlPoint, CreasingMethod, Document, EdgeKind, EdgeTag, GradientMesh,
+    WedgeOverride,
 };
-pub use refine::{Refinement, RefinedMesh};
+pub use refine::{RefinedMesh, Refinement};
 pub use topology::Topology;
 pub use validate::validate;

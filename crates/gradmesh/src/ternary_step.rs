@@ -157,10 +157,7 @@ pub fn ternary_data(base: &BaseMesh) -> Vec<VertexData> {
         let fv = t.face_vertices(f);
         let fe = t.face_edges(f);
         let n = fv.len();
-        let centroid = fv
-            .iter()
-            .fold(Vec2::ZERO, |acc, &v| acc + pos(v).to_vec2())
-            / n as f64;
+        let centroid = fv.iter().fold(Vec2::ZERO, |acc, &v| acc + pos(v).to_vec2()) / n as f64;
         let c = centroid.to_point();
         for i in 0..n {
             let (next, prev) = ((i + 1) % n, (i + n - 1) % n);

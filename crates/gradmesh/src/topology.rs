@@ -140,8 +140,10 @@ impl Topology {
                 }
                 push_edge(group);
             } else {
-                let mut faces: Vec<usize> =
-                    group.iter().map(|&h| corner_face[h as usize] as usize).collect();
+                let mut faces: Vec<usize> = group
+                    .iter()
+                    .map(|&h| corner_face[h as usize] as usize)
+                    .collect();
                 faces.sort_unstable();
                 return Err(ErrorKind::NonManifoldEdge {
                     a: k.0,
@@ -175,8 +177,8 @@ impl Topology {
         ring_offsets.push(0);
         edge_ring_offsets.push(0);
         for v in 0..vertex_count {
-            let corners = &vert_corners
-                [vert_corner_offsets[v] as usize..vert_corner_offsets[v + 1] as usize];
+            let corners =
+                &vert_corners[vert_corner_offsets[v] as usize..vert_corner_offsets[v + 1] as usize];
             if let Some(&c0) = corners.first() {
                 // Walk backwards to the start of the fan: the corner whose incoming half-edge
                 // has no twin, or all the way round.
@@ -303,8 +305,7 @@ impl Topology {
 
     /// The edges around vertex `v`, in ring order; one more than the faces on a boundary.
     pub fn vertex_edges(&self, v: usize) -> &[u32] {
-        &self.ring_edges
-            [self.edge_ring_offsets[v] as usize..self.edge_ring_offsets[v + 1] as usize]
+        &self.ring_edges[self.edge_ring_offsets[v] as usize..self.edge_ring_offsets[v + 1] as usize]
     }
 
     /// Whether vertex `v` lies on a boundary (or has no face at all).
@@ -419,17 +420,29 @@ mod tests {
     #[test]
     fn rejects_bad_meshes() {
         let e = Topology::from_faces(4, &[vec![0, 1, 2], vec![0, 1, 3]]).unwrap_err();
-        assert!(matches!(e, ErrorKind::InconsistentWinding { a: 0, b: 1, .. }), "{e:?}");
-        let e = Topology::from_faces(5, &[vec![0, 1, 2], vec![1, 0, 3], vec![0, 1, 4]])
-            .unwrap_err();
+        assert!(
+            matches!(e, ErrorKind::InconsistentWinding { a: 0, b: 1, .. }),
+            "{e:?}"
+        );
+        let e =
+            Topology::from_faces(5, &[vec![0, 1, 2], vec![1, 0, 3], vec![0, 1, 4]]).unwrap_err();
         assert!(matches!(e, ErrorKind::NonManifoldEdge { .. }), "{e:?}");
         // Two triangles touching at a single point: a bow tie.
         let e = Topology::from_faces(5, &[vec![0, 1, 2], vec![0, 3, 4]]).unwrap_err();
-        assert!(matches!(e, ErrorKind::NonManifoldVertex { point: 0, fans: 2 }), "{e:?}");
+        assert!(
+            matches!(e, ErrorKind::NonManifoldVertex { point: 0, fans: 2 }),
+            "{e:?}"
+        );
         let e = Topology::from_faces(3, &[vec![0, 1]]).unwrap_err();
-        assert!(matches!(e, ErrorKind::DegenerateFace { face: 0, .. }), "{e:?}");
+        assert!(
+            matches!(e, ErrorKind::DegenerateFace { face: 0, .. }),
+            "{e:?}"
+        );
         let e = Topology::from_faces(3, &[vec![0, 1, 7]]).unwrap_err();
-        assert!(matches!(e, ErrorKind::IndexOutOfRange { index: 7, .. }), "{e:?}");
+        assert!(
+            matches!(e, ErrorKind::IndexOutOfRange { index: 7, .. }),
+            "{e:?}"
+        );
     }
 
     #[test]

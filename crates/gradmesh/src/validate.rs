@@ -73,8 +73,7 @@ impl BaseMesh {
 
         // The user's topology, whole: it must be manifold before any cut.
         let whole = Topology::from_faces(n, &mesh.faces)?;
-        let mut edge_index: HashMap<(u32, u32), usize> =
-            HashMap::with_capacity(whole.edge_count());
+        let mut edge_index: HashMap<(u32, u32), usize> = HashMap::with_capacity(whole.edge_count());
         for e in 0..whole.edge_count() {
             let [a, b] = whole.edge_vertices(e);
             edge_index.insert(edge_key(a, b), e);
@@ -114,8 +113,8 @@ impl BaseMesh {
                 }
                 .into());
             }
-            let len = (mesh.points[to as usize].position - mesh.points[from as usize].position)
-                .hypot();
+            let len =
+                (mesh.points[to as usize].position - mesh.points[from as usize].position).hypot();
             if h.hypot() > 0.5 * len * (1.0 + 1e-9) {
                 warn(
                     &mut warnings,
@@ -167,7 +166,11 @@ impl BaseMesh {
                 for (k, w) in wedge_of_face.iter_mut().enumerate() {
                     // Number of cuts at ring edges <= k (edge k precedes face k).
                     let c = cuts.iter().filter(|&&e| e <= k).count();
-                    *w = if boundary { c } else { (c + cuts.len() - 1) % cuts.len() };
+                    *w = if boundary {
+                        c
+                    } else {
+                        (c + cuts.len() - 1) % cuts.len()
+                    };
                 }
             }
             let mut ids = vec![v as u32];
@@ -204,7 +207,10 @@ impl BaseMesh {
         for (i, w) in mesh.wedges.iter().enumerate() {
             let what = format!("wedge {i} (point {}, face {})", w.point, w.face);
             if w.point as usize >= n || w.face as usize >= mesh.faces.len() {
-                return Err(invalid(what, "refers to a point or face that does not exist"));
+                return Err(invalid(
+                    what,
+                    "refers to a point or face that does not exist",
+                ));
             }
             let Some(id) = (0..split_count)
                 .find(|&s| source_point[s] == w.point && wedge_faces[s].contains(&w.face))
@@ -277,10 +283,7 @@ impl BaseMesh {
 
         for v in 0..n {
             if whole.vertex_faces(v).is_empty() {
-                warn(
-                    &mut warnings,
-                    format!("point {v} is not used by any face"),
-                );
+                warn(&mut warnings, format!("point {v} is not used by any face"));
             }
         }
         for (v, p) in mesh.points.iter().enumerate() {
@@ -375,7 +378,10 @@ fn check_numbers(mesh: &GradientMesh) -> Result<(), Error> {
         }
         for (to, h) in &w.handles {
             if !h.x.is_finite() || !h.y.is_finite() {
-                return Err(not_finite(format!("wedge {i} handle towards {to}"), h.x + h.y));
+                return Err(not_finite(
+                    format!("wedge {i} handle towards {to}"),
+                    h.x + h.y,
+                ));
             }
         }
     }
