@@ -1,0 +1,1 @@
+//! Rendering the limit surface to pixels.
