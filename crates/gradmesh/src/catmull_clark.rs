@@ -4,10 +4,10 @@
 //! Topology and stencils depend only on connectivity and sharpness, never on positions or
 //! colours, so they are computed once and any per-vertex data is refined by applying them.
 
-use crate::mesh::CreasingMethod;
+use crate::mesh::{BoundaryInterpolation, CreasingMethod, SHARPNESS_INFINITE};
 use crate::rules::{self, VertexRule};
 use crate::topology::{Topology, INVALID};
-use crate::validate::VertexData;
+use crate::validate::{BaseMesh, VertexData};
 
 /// One refinement level: topology plus the sharpness that drives the rules.
 #[derive(Clone, Debug)]
@@ -23,6 +23,48 @@ pub struct Level {
 }
 
 impl Level {
+    /// A level with the boundary rules applied: boundary edges infinitely sharp and, under
+    /// [`BoundaryInterpolation::EdgeAndCorner`], boundary vertices with a single face made
+    /// corners (as OpenSubdiv does to its base level).
+    pub fn new(
+        topology: Topology,
+        mut edge_sharpness: Vec<f64>,
+        mut vertex_sharpness: Vec<f64>,
+        creasing: CreasingMethod,
+        boundary: BoundaryInterpolation,
+    ) -> Level {
+        for (e, s) in edge_sharpness.iter_mut().enumerate() {
+            if topology.is_boundary_edge(e) {
+                *s = SHARPNESS_INFINITE;
+            }
+        }
+        if boundary == BoundaryInterpolation::EdgeAndCorner {
+            for (v, s) in vertex_sharpness.iter_mut().enumerate() {
+                if topology.is_boundary_vertex(v) && topology.vertex_faces(v).len() == 1 {
+                    *s = SHARPNESS_INFINITE;
+                }
+            }
+        }
+        Level {
+            topology,
+            edge_sharpness,
+            vertex_sharpness,
+            creasing,
+        }
+    }
+
+    /// The base level itself as a Catmull-Clark level, for plain Catmull-Clark refinement
+    /// without the ternary step (to compare schemes, or to check against OpenSubdiv).
+    pub fn from_base(base: &BaseMesh) -> Level {
+        Level::new(
+            base.topology.clone(),
+            base.edge_sharpness.clone(),
+            base.vertex_sharpness.clone(),
+            base.creasing,
+            base.boundary,
+        )
+    }
+
     /// The sharpness of the edges around `v`, in ring order.
     pub fn incident_sharpness(&self, v: usize) -> Vec<f64> {
         self.topology
@@ -317,7 +359,6 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::SHARPNESS_INFINITE;
 
     fn level(faces: &[Vec<u32>], nv: usize) -> Level {
         let topology = Topology::from_faces(nv, faces).unwrap();

@@ -4,11 +4,31 @@
 //! Topologically Unrestricted Gradient Meshes" (Computer Graphics Forum 36(6), 2017):
 //!
 //! 1. [`GradientMesh`]: control points with colours, handles and edge tags, checked by
-//!    [`validate`];
-//! 2. [`ternary_step`]: the special first refinement that makes colours interpolating;
-//! 3. [`catmull_clark`]: Catmull-Clark refinement with Pixar's rules, topology refined once and
+//!    [`validate`](fn@validate);
+//! 2. [`ternary_step`](mod@ternary_step): the special first refinement that makes colours interpolating;
+//! 3. [`catmull_clark`](mod@catmull_clark): Catmull-Clark refinement with Pixar's rules, topology refined once and
 //!    data interpolated with precomputed stencils;
-//! 4. [`limit`]: limit positions and colours of refined vertices.
+//! 4. [`limit`](mod@limit): limit positions and colours of refined vertices.
+//!
+//! ```
+//! use gradmesh::{refine::Refinement, ColourSpace, GradientMesh};
+//! use kurbo::Point;
+//!
+//! let mut mesh = GradientMesh::new(ColourSpace::Lab);
+//! let a = mesh.add_point(Point::new(0.0, 0.0), [50.0, 60.0, 40.0]);
+//! let b = mesh.add_point(Point::new(100.0, 0.0), [90.0, -10.0, 80.0]);
+//! let c = mesh.add_point(Point::new(50.0, 90.0), [40.0, 10.0, -50.0]);
+//! mesh.add_face(vec![a, b, c]);
+//!
+//! // Topology of levels 0..=3 is built once; data is evaluated with precomputed stencils.
+//! let (mut refinement, warnings) = Refinement::new(&mesh, 3)?;
+//! assert!(warnings.is_empty());
+//! let data = refinement.evaluate();
+//! // Limit position, colour and opacity of every level-3 vertex. Point `a` keeps its colour.
+//! let limit = refinement.limit(&data, 3);
+//! assert!((limit[refinement.vertex_at_level(a, 3)][2] - 50.0).abs() < 1e-12);
+//! # Ok::<(), gradmesh::Error>(())
+//! ```
 
 pub mod catmull_clark;
 pub mod colour;

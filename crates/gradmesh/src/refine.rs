@@ -84,6 +84,17 @@ impl Refinement {
         }
     }
 
+    /// The index at level `k` of the vertex that base vertex `v` becomes (its vertex point at
+    /// every level). Levels beyond [`Refinement::depth`] are not built: `k` must not exceed it.
+    pub fn vertex_at_level(&self, v: u32, k: usize) -> usize {
+        let mut index = v as usize;
+        for j in 1..k {
+            let t = self.topology(j);
+            index += t.face_count() + t.edge_count();
+        }
+        index
+    }
+
     /// The stencils from level `k >= 1` to level `k + 1`.
     pub fn stencils(&self, k: usize) -> &Stencils {
         &self.stencils[k - 1]

@@ -9,7 +9,6 @@
 use kurbo::{Point, Vec2};
 
 use crate::catmull_clark::Level;
-use crate::mesh::{BoundaryInterpolation, SHARPNESS_INFINITE};
 use crate::topology::Topology;
 use crate::validate::{BaseMesh, VertexData};
 
@@ -94,27 +93,15 @@ pub fn ternary_level(base: &BaseMesh) -> Level {
             edge_sharpness[next_corner_quad[3] as usize] = s;
         }
     }
-    for (e, s) in edge_sharpness.iter_mut().enumerate() {
-        if topology.is_boundary_edge(e) {
-            *s = SHARPNESS_INFINITE;
-        }
-    }
     let mut vertex_sharpness = vec![0.0; nv1];
-    for v in 0..t.vertex_count() {
-        vertex_sharpness[v] = base.vertex_sharpness[v];
-        if base.boundary == BoundaryInterpolation::EdgeAndCorner
-            && topology.is_boundary_vertex(v)
-            && topology.vertex_faces(v).len() == 1
-        {
-            vertex_sharpness[v] = SHARPNESS_INFINITE;
-        }
-    }
-    Level {
+    vertex_sharpness[..t.vertex_count()].copy_from_slice(&base.vertex_sharpness);
+    Level::new(
         topology,
         edge_sharpness,
         vertex_sharpness,
-        creasing: base.creasing,
-    }
+        base.creasing,
+        base.boundary,
+    )
 }
 
 /// The position of the face point at corner `V0` of a face (the bilinear rule of section 4.3,

@@ -1,0 +1,140 @@
+//! Catmull-Clark refinement and limit points against `opensubdiv-rs` (a port of OpenSubdiv).
+//!
+//! Plain Catmull-Clark (no ternary step) on random meshes with triangles, quads and hexagons,
+//! infinitely sharp and semi-sharp creases, corners, and both boundary interpolations. The
+//! oracle's weights are f32, so values are compared at 1e-5 relative; vertices are matched by
+//! position since the two number them differently. Not compared: Chaikin creasing and interior
+//! valence-2 vertices, where the port is known to differ from OpenSubdiv.
+
+mod common;
+
+use common::{build, mesh_spec};
+use gradmesh::catmull_clark::{self, Level};
+use gradmesh::limit::limit_stencils;
+use gradmesh::mesh::SHARPNESS_INFINITE;
+use gradmesh::validate::{BaseMesh, VertexData};
+use gradmesh::{BoundaryInterpolation, GradientMesh};
+use opensubdiv_rs::far::{
+    PrimvarRefiner, TopologyDescriptor, TopologyRefinerFactory, UniformOptions,
+};
+use opensubdiv_rs::sdc;
+use proptest::prelude::*;
+
+const DEPTH: usize = 3;
+
+/// Ours: levels 0..=DEPTH and the limit of the last level.
+fn ours(mesh: &GradientMesh) -> (Vec<Vec<VertexData>>, Vec<VertexData>) {
+    let (base, _) = BaseMesh::new(mesh).unwrap();
+    let mut level = Level::from_base(&base);
+    let mut data = vec![base.data.clone()];
+    for _ in 0..DEPTH {
+        let (child, stencils) = catmull_clark::refine(&level);
+        data.push(stencils.apply(data.last().unwrap()));
+        level = child;
+    }
+    let limit = limit_stencils(&level).unwrap().apply(data.last().unwrap());
+    (data, limit)
+}
+
+/// The oracle's levels 0..=DEPTH and the limit of the last level.
+fn oracle(mesh: &GradientMesh) -> (Vec<Vec<VertexData>>, Vec<VertexData>) {
+    let sizes: Vec<usize> = mesh.faces.iter().map(Vec::len).collect();
+    let verts: Vec<u32> = mesh.faces.iter().flatten().copied().collect();
+    let mut pairs = Vec::new();
+    let mut weights = Vec::new();
+    for (&(a, b), tag) in &mesh.edges {
+        pairs.push([a, b]);
+        weights.push(tag.effective_sharpness() as f32);
+    }
+    let corners: Vec<u32> = (0..mesh.points.len() as u32)
+        .filter(|&v| mesh.points[v as usize].corner)
+        .collect();
+    let corner_weights = vec![SHARPNESS_INFINITE as f32; corners.len()];
+    let descriptor = TopologyDescriptor::new(mesh.points.len(), &sizes, &verts)
+        .with_creases(&pairs, &weights)
+        .with_corners(&corners, &corner_weights);
+    let boundary = match mesh.boundary {
+        BoundaryInterpolation::EdgeAndCorner => sdc::VtxBoundaryInterpolation::EdgeAndCorner,
+        BoundaryInterpolation::EdgeOnly => sdc::VtxBoundaryInterpolation::EdgeOnly,
+    };
+    let mut refiner = TopologyRefinerFactory::create(
+        descriptor,
+        sdc::SchemeType::Catmark,
+        sdc::Options::default().with_vtx_boundary_interpolation(boundary),
+    )
+    .expect("valid topology");
+    refiner.refine_uniform(UniformOptions::new(DEPTH));
+    let primvars = PrimvarRefiner::new(&refiner);
+    let base: Vec<VertexData> = mesh
+        .points
+        .iter()
+        .map(|p| {
+            [
+                p.position.x,
+                p.position.y,
+                p.colour[0],
+                p.colour[1],
+                p.colour[2],
+                p.opacity,
+            ]
+        })
+        .collect();
+    let mut data = vec![base];
+    for level in 1..=DEPTH {
+        let mut next = vec![[0.0; 6]; refiner.level(level).num_vertices()];
+        primvars.interpolate(level, data.last().unwrap(), &mut next);
+        data.push(next);
+    }
+    let mut limit = vec![[0.0; 6]; data[DEPTH].len()];
+    primvars.limit(&data[DEPTH], &mut limit);
+    (data, limit)
+}
+
+/// Checks that every vertex of `a` has a vertex of `b` at the same position with the same
+/// data, at 1e-5 relative to the size of the values.
+fn same_points(a: &[VertexData], b: &[VertexData], what: &str) -> Result<(), TestCaseError> {
+    prop_assert_eq!(a.len(), b.len(), "{}: vertex count", what);
+    let mut order: Vec<usize> = (0..b.len()).collect();
+    order.sort_by(|&i, &j| b[i][0].total_cmp(&b[j][0]));
+    let xs: Vec<f64> = order.iter().map(|&i| b[i][0]).collect();
+    let tol = |x: f64| 1e-5 * x.abs().max(100.0);
+    for p in a {
+        let start = xs.partition_point(|&x| x < p[0] - tol(p[0]));
+        let found = order[start..]
+            .iter()
+            .take_while(|&&i| b[i][0] <= p[0] + tol(p[0]))
+            .any(|&i| (0..6).all(|c| (b[i][c] - p[c]).abs() <= tol(p[c])));
+        prop_assert!(found, "{}: no match for {:?}", what, p);
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 40, .. ProptestConfig::default() })]
+
+    #[test]
+    fn catmull_clark_matches_opensubdiv(spec in mesh_spec(), edge_only in any::<bool>()) {
+        let mut mesh = build(&spec);
+        if edge_only {
+            mesh.boundary = BoundaryInterpolation::EdgeOnly;
+        }
+        // Add semi-sharp creases of several sharpness values.
+        let keys: Vec<(u32, u32)> = mesh.edges.keys().copied().collect();
+        for (k, key) in keys.iter().enumerate() {
+            if let Some(tag) = mesh.edges.get_mut(key) {
+                tag.sharpness = match k % 4 {
+                    0 => None,
+                    1 => Some(0.5),
+                    2 => Some(1.5),
+                    _ => Some(2.25),
+                };
+            }
+        }
+        let (a, la) = ours(&mesh);
+        let (b, lb) = oracle(&mesh);
+        for k in 1..=DEPTH {
+            same_points(&a[k], &b[k], &format!("level {k}"))?;
+        }
+        same_points(&la, &lb, "limit")?;
+    }
+}
