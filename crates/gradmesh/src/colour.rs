@@ -1,6 +1,7 @@
 //! Working colour spaces, conversion to and from sRGB, and CSS colour strings.
 
-use palette::{white_point::D65, FromColor, Lab, LinSrgb, Oklab};
+use palette::convert::FromColorUnclamped;
+use palette::{white_point::D65, Lab, LinSrgb, Oklab};
 
 /// The space in which a mesh's colours are given and interpolated.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -44,8 +45,12 @@ impl ColourSpace {
     /// result may lie outside 0..1.
     pub fn to_linear_srgb(self, c: [f64; 3]) -> [f64; 3] {
         let lin: LinSrgb<f64> = match self {
-            ColourSpace::Lab => LinSrgb::from_color(Lab::<D65, f64>::new(c[0], c[1], c[2])),
-            ColourSpace::Oklab => LinSrgb::from_color(Oklab::<f64>::new(c[0], c[1], c[2])),
+            ColourSpace::Lab => {
+                LinSrgb::from_color_unclamped(Lab::<D65, f64>::new(c[0], c[1], c[2]))
+            }
+            ColourSpace::Oklab => {
+                LinSrgb::from_color_unclamped(Oklab::<f64>::new(c[0], c[1], c[2]))
+            }
             ColourSpace::SrgbLinear => return c,
             ColourSpace::Srgb => return [srgb_decode(c[0]), srgb_decode(c[1]), srgb_decode(c[2])],
         };
@@ -57,11 +62,11 @@ impl ColourSpace {
         let lin = LinSrgb::<f64>::new(rgb[0], rgb[1], rgb[2]);
         match self {
             ColourSpace::Lab => {
-                let lab = Lab::<D65, f64>::from_color(lin);
+                let lab = Lab::<D65, f64>::from_color_unclamped(lin);
                 [lab.l, lab.a, lab.b]
             }
             ColourSpace::Oklab => {
-                let ok = Oklab::<f64>::from_color(lin);
+                let ok = Oklab::<f64>::from_color_unclamped(lin);
                 [ok.l, ok.a, ok.b]
             }
             ColourSpace::SrgbLinear => rgb,
@@ -145,6 +150,19 @@ mod tests {
             for (x, y) in back.iter().zip([0.2, 0.5, 0.7]) {
                 assert!((x - y).abs() < 1e-6, "{space:?}: {back:?}");
             }
+        }
+    }
+
+    #[test]
+    fn conversions_do_not_clamp() {
+        // A Lab colour far outside sRGB converts to linear values outside 0..1 and back
+        // (palette's matrices are not exact inverses: about 1e-6 relative).
+        let lab = [50.0, 150.0, 0.0];
+        assert!(!ColourSpace::Lab.in_srgb_gamut(lab));
+        let back =
+            ColourSpace::SrgbLinear.convert(ColourSpace::Lab, ColourSpace::Lab.to_linear_srgb(lab));
+        for (x, y) in back.iter().zip(lab) {
+            assert!((x - y).abs() < 1e-3, "{back:?}");
         }
     }
 
