@@ -191,13 +191,13 @@ fn face_centroid_terms(t: &Topology, f: usize, scale: f64, terms: &mut Vec<(u32,
     terms.extend(verts.iter().map(|&v| (v, w)));
 }
 
-/// Adds the terms of the vertex mask of `rule` at vertex `v`, scaled by `scale`. `sharp` tells
-/// which ring edges count as sharp for the crease mask.
+/// Adds the terms of the vertex mask of `rule` at vertex `v`, scaled by `scale`. `sharp(k)`
+/// tells whether ring edge `k` counts as sharp for the crease mask.
 fn vertex_mask_terms(
     parent: &Level,
     v: usize,
     rule: VertexRule,
-    sharp: &[bool],
+    sharp: impl Fn(usize) -> bool,
     scale: f64,
     terms: &mut Vec<(u32, f64)>,
 ) {
@@ -207,7 +207,7 @@ fn vertex_mask_terms(
         VertexRule::Crease => {
             terms.push((v as u32, 0.75 * scale));
             for (k, &e) in t.vertex_edges(v).iter().enumerate() {
-                if sharp[k] {
+                if sharp(k) {
                     terms.push((t.other_vertex(e as usize, v as u32), 0.125 * scale));
                 }
             }
@@ -236,31 +236,9 @@ fn vertex_mask_terms(
 pub fn refine(parent: &Level) -> (Level, Stencils) {
     let t = &parent.topology;
     let (nf, ne, nv) = (t.face_count(), t.edge_count(), t.vertex_count());
-    let face_point = |f: usize| f as u32;
-    let edge_point = |e: u32| (nf + e as usize) as u32;
     let vertex_point = |v: u32| (nf + ne + v as usize) as u32;
 
-    // Child faces.
-    let corners = t.corner_count();
-    let mut offsets = Vec::with_capacity(corners + 1);
-    let mut verts = Vec::with_capacity(4 * corners);
-    offsets.push(0u32);
-    for f in 0..nf {
-        let fv = t.face_vertices(f);
-        let fe = t.face_edges(f);
-        let n = fv.len();
-        for i in 0..n {
-            verts.extend_from_slice(&[
-                vertex_point(fv[i]),
-                edge_point(fe[i]),
-                face_point(f),
-                edge_point(fe[(i + n - 1) % n]),
-            ]);
-            offsets.push(verts.len() as u32);
-        }
-    }
-    let child_topology = Topology::build(nf + ne + nv, offsets, verts, |_, _| false)
-        .expect("a refined manifold mesh is manifold");
+    let child_topology = t.subdivide();
 
     // Child sharpness: vertex sharpness decays; each half of a parent edge gets the sharpness
     // subdivided at its end vertex; edges inside parent faces are smooth.
@@ -269,13 +247,17 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
         child_vertex_sharpness[vertex_point(v as u32) as usize] =
             rules::decrement_sharpness(parent.vertex_sharpness[v]);
     }
-    let incident: Vec<Vec<f64>> = (0..nv).map(|v| parent.incident_sharpness(v)).collect();
+    // Only Chaikin creasing looks at the other edges around the vertex.
     let half_sharpness = |e: u32, v: u32| -> f64 {
-        rules::child_edge_sharpness(
-            parent.creasing,
-            parent.edge_sharpness[e as usize],
-            &incident[v as usize],
-        )
+        let s = parent.edge_sharpness[e as usize];
+        match parent.creasing {
+            CreasingMethod::Uniform => rules::decrement_sharpness(s),
+            CreasingMethod::Chaikin => rules::child_edge_sharpness(
+                parent.creasing,
+                s,
+                &parent.incident_sharpness(v as usize),
+            ),
+        }
     };
     let mut child_edge_sharpness = vec![0.0; child_topology.edge_count()];
     for f in 0..nf {
@@ -329,9 +311,10 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
         let cv = vertex_point(v as u32) as usize;
         let parent_rule = parent.vertex_rule(v);
         let child_rule = child.vertex_rule(cv);
-        let parent_sharp: Vec<bool> = incident[v].iter().map(|&s| rules::is_sharp(s)).collect();
+        let parent_sharp =
+            |k: usize| rules::is_sharp(parent.edge_sharpness[t.vertex_edges(v)[k] as usize]);
         if parent_rule == child_rule || parent_rule <= VertexRule::Dart {
-            vertex_mask_terms(parent, v, parent_rule, &parent_sharp, 1.0, &mut terms);
+            vertex_mask_terms(parent, v, parent_rule, parent_sharp, 1.0, &mut terms);
         } else {
             // The rule relaxes at this level: blend the two masks (Pixar's semi-sharp rule).
             // Child ring edge k is the half of parent ring edge k at this vertex.
@@ -340,16 +323,15 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
                 .iter()
                 .map(|&e| half_sharpness(e, v as u32))
                 .collect();
-            let child_sharp: Vec<bool> =
-                child_incident.iter().map(|&s| rules::is_sharp(s)).collect();
+            let child_sharp = |k: usize| rules::is_sharp(child_incident[k]);
             let w = rules::fractional_weight(
                 parent.vertex_sharpness[v],
                 child.vertex_sharpness[cv],
-                &incident[v],
+                &parent.incident_sharpness(v),
                 &child_incident,
             );
-            vertex_mask_terms(parent, v, parent_rule, &parent_sharp, w, &mut terms);
-            vertex_mask_terms(parent, v, child_rule, &child_sharp, 1.0 - w, &mut terms);
+            vertex_mask_terms(parent, v, parent_rule, parent_sharp, w, &mut terms);
+            vertex_mask_terms(parent, v, child_rule, child_sharp, 1.0 - w, &mut terms);
         }
         stencils.push(&mut terms);
     }

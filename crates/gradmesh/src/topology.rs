@@ -85,12 +85,30 @@ impl Topology {
             }
         }
         let head = |h: usize| face_verts[next_corner[h] as usize];
-        let mut order: Vec<u32> = (0..corner_count as u32).collect();
         let key = |h: u32| {
             let (a, b) = (face_verts[h as usize], head(h as usize));
             (a.min(b), a.max(b))
         };
-        order.sort_unstable_by_key(|&h| (key(h), h));
+        // Group half-edges by their undirected key: bucket by the smaller vertex (linear
+        // time), then sort each small bucket by the larger one.
+        let mut bucket_start = vec![0u32; vertex_count + 1];
+        for h in 0..corner_count as u32 {
+            bucket_start[key(h).0 as usize + 1] += 1;
+        }
+        for v in 0..vertex_count {
+            bucket_start[v + 1] += bucket_start[v];
+        }
+        let mut fill = bucket_start.clone();
+        let mut order = vec![0u32; corner_count];
+        for h in 0..corner_count as u32 {
+            let b = &mut fill[key(h).0 as usize];
+            order[*b as usize] = h;
+            *b += 1;
+        }
+        for v in 0..vertex_count {
+            order[bucket_start[v] as usize..bucket_start[v + 1] as usize]
+                .sort_unstable_by_key(|&h| (key(h).1, h));
+        }
 
         let mut twin = vec![INVALID; corner_count];
         let mut face_edges = vec![INVALID; corner_count];
@@ -331,6 +349,164 @@ impl Topology {
         used as i64 - self.edge_count() as i64 + self.face_count() as i64
     }
 
+    /// The topology after one Catmull-Clark split, built directly from this one (no search
+    /// for twins): one face point per face, then one edge point per edge, then one vertex
+    /// point per vertex. Child face `c` is the quad at flat corner `c`: `[vertex point, edge
+    /// point of the outgoing edge, face point, edge point of the incoming edge]`. Child edges:
+    /// `2 e + k` is the half of edge `e` at its end `k`; `2 E + c` joins the edge point of the
+    /// outgoing edge at corner `c` to the face point.
+    pub fn subdivide(&self) -> Topology {
+        let (nf, ne, nv, nc) = (
+            self.face_count(),
+            self.edge_count(),
+            self.vertex_count,
+            self.corner_count(),
+        );
+        let fp = |f: usize| f as u32;
+        let ep = |e: u32| (nf + e as usize) as u32;
+        let vp = |v: u32| (nf + ne + v as usize) as u32;
+        let half = |e: u32, k: usize| 2 * e + k as u32;
+        let inner = |c: usize| (2 * ne + c) as u32;
+        let end_at = |e: u32, v: u32| usize::from(self.edge_verts[e as usize][0] != v);
+
+        let mut corner_face = vec![0u32; nc];
+        for f in 0..nf {
+            corner_face[self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize]
+                .fill(f as u32);
+        }
+        let next = |c: usize| {
+            let f = corner_face[c] as usize;
+            if c + 1 == self.face_offsets[f + 1] as usize {
+                self.face_offsets[f] as usize
+            } else {
+                c + 1
+            }
+        };
+        let prev = |c: usize| {
+            let f = corner_face[c] as usize;
+            if c == self.face_offsets[f] as usize {
+                self.face_offsets[f + 1] as usize - 1
+            } else {
+                c - 1
+            }
+        };
+        // The corner at which each edge leaves its end 0 (in its first face) and its end 1
+        // (in its second face).
+        let mut leaving = vec![[INVALID; 2]; ne];
+        for c in 0..nc {
+            let e = self.face_edges[c] as usize;
+            let side = usize::from(self.face_verts[c] != self.edge_verts[e][0]);
+            leaving[e][side] = c as u32;
+        }
+
+        let mut face_offsets = Vec::with_capacity(nc + 1);
+        let mut face_verts = Vec::with_capacity(4 * nc);
+        let mut face_edges = Vec::with_capacity(4 * nc);
+        for c in 0..nc {
+            face_offsets.push(4 * c as u32);
+            let (v, f) = (self.face_verts[c], corner_face[c] as usize);
+            let (out, inc) = (self.face_edges[c], self.face_edges[prev(c)]);
+            face_verts.extend_from_slice(&[vp(v), ep(out), fp(f), ep(inc)]);
+            face_edges.extend_from_slice(&[
+                half(out, end_at(out, v)),
+                inner(c),
+                inner(prev(c)),
+                half(inc, end_at(inc, v)),
+            ]);
+        }
+        face_offsets.push(4 * nc as u32);
+
+        let child_face = |c: u32| if c == INVALID { INVALID } else { c };
+        let mut edge_verts = Vec::with_capacity(2 * ne + nc);
+        let mut edge_faces = Vec::with_capacity(2 * ne + nc);
+        for e in 0..ne {
+            let [a, b] = self.edge_verts[e];
+            let [c0, c1] = leaving[e];
+            let after = |c: u32| {
+                if c == INVALID {
+                    INVALID
+                } else {
+                    next(c as usize) as u32
+                }
+            };
+            edge_verts.push([vp(a), ep(e as u32)]);
+            edge_faces.push([child_face(c0), after(c1)]);
+            edge_verts.push([ep(e as u32), vp(b)]);
+            edge_faces.push([after(c0), child_face(c1)]);
+        }
+        for c in 0..nc {
+            edge_verts.push([ep(self.face_edges[c]), fp(corner_face[c] as usize)]);
+            edge_faces.push([c as u32, next(c) as u32]);
+        }
+
+        let child_vertices = nf + ne + nv;
+        let mut ring_offsets = Vec::with_capacity(child_vertices + 1);
+        let mut ring_faces = Vec::with_capacity(4 * nc);
+        let mut ring_corners = Vec::with_capacity(4 * nc);
+        let mut edge_ring_offsets = Vec::with_capacity(child_vertices + 1);
+        let mut ring_edges = Vec::with_capacity(4 * nc + nv);
+        ring_offsets.push(0);
+        edge_ring_offsets.push(0);
+        let mut close = |ring_faces: &Vec<u32>, ring_edges: &Vec<u32>| {
+            ring_offsets.push(ring_faces.len() as u32);
+            edge_ring_offsets.push(ring_edges.len() as u32);
+        };
+        // Face points: round the face backwards.
+        for f in 0..nf {
+            let (o, n) = (self.face_offsets[f] as usize, self.face_vertices(f).len());
+            for k in 0..n {
+                let c = o + (n - k) % n;
+                ring_faces.push(c as u32);
+                ring_corners.push(2);
+                ring_edges.push(inner(c));
+            }
+            close(&ring_faces, &ring_edges);
+        }
+        // Edge points: two faces on each side of the edge.
+        for e in 0..ne {
+            let [c0, c1] = leaving[e];
+            let c0n = next(c0 as usize) as u32;
+            ring_faces.extend_from_slice(&[c0, c0n]);
+            ring_corners.extend_from_slice(&[1, 3]);
+            ring_edges.extend_from_slice(&[
+                half(e as u32, 0),
+                inner(c0 as usize),
+                half(e as u32, 1),
+            ]);
+            if c1 != INVALID {
+                ring_faces.extend_from_slice(&[c1, next(c1 as usize) as u32]);
+                ring_corners.extend_from_slice(&[1, 3]);
+                ring_edges.push(inner(c1 as usize));
+            }
+            close(&ring_faces, &ring_edges);
+        }
+        // Vertex points: the parent ring, mapped.
+        for v in 0..nv {
+            for (&f, &c) in self.vertex_faces(v).iter().zip(self.vertex_face_corners(v)) {
+                ring_faces.push(self.face_offsets[f as usize] + c);
+                ring_corners.push(0);
+            }
+            for &e in self.vertex_edges(v) {
+                ring_edges.push(half(e, end_at(e, v as u32)));
+            }
+            close(&ring_faces, &ring_edges);
+        }
+
+        Topology {
+            vertex_count: child_vertices,
+            face_offsets,
+            face_verts,
+            face_edges,
+            edge_verts,
+            edge_faces,
+            ring_offsets,
+            ring_faces,
+            ring_corners,
+            edge_ring_offsets,
+            ring_edges,
+        }
+    }
+
     /// Whether every face is a quad.
     pub fn is_all_quads(&self) -> bool {
         (0..self.face_count()).all(|f| self.face_vertices(f).len() == 4)
@@ -413,6 +589,75 @@ mod tests {
             for (k, &f) in faces.iter().enumerate() {
                 let fe = t.face_edges(f as usize);
                 assert!(fe.contains(&edges[k]) && fe.contains(&edges[(k + 1) % edges.len()]));
+            }
+        }
+    }
+
+    /// The direct construction gives the same connectivity as building from the child faces.
+    #[test]
+    fn subdivide_matches_a_rebuild() {
+        let mut faces = grid(3);
+        faces.remove(4); // a hole
+        let mut mixed = faces.clone();
+        let q = mixed.remove(0);
+        mixed.push(vec![q[0], q[1], q[2]]);
+        mixed.push(vec![q[0], q[2], q[3]]);
+        for faces in [faces, mixed] {
+            let t = Topology::from_faces(16, &faces).unwrap();
+            let child = t.subdivide();
+            let (o, v) = (child.face_offsets.clone(), child.face_verts.clone());
+            let rebuilt = Topology::build(child.vertex_count(), o, v, |_, _| false).unwrap();
+            assert_eq!(child.face_count(), rebuilt.face_count());
+            assert_eq!(child.edge_count(), rebuilt.edge_count());
+            // Same edges around every face (edge ids differ: compare by end vertices).
+            let ends = |t: &Topology, e: u32| {
+                let [a, b] = t.edge_vertices(e as usize);
+                (a.min(b), a.max(b))
+            };
+            for f in 0..child.face_count() {
+                for (e1, e2) in child.face_edges(f).iter().zip(rebuilt.face_edges(f)) {
+                    assert_eq!(ends(&child, *e1), ends(&rebuilt, *e2));
+                }
+            }
+            for e in 0..child.edge_count() {
+                let [a, b] = child.edge_vertices(e);
+                let [f0, f1] = child.edge_faces(e);
+                // f0 runs a->b.
+                let fv = child.face_vertices(f0 as usize);
+                let k = fv.iter().position(|&x| x == a).unwrap();
+                assert_eq!(fv[(k + 1) % 4], b);
+                if f1 != INVALID {
+                    let fv = child.face_vertices(f1 as usize);
+                    let k = fv.iter().position(|&x| x == b).unwrap();
+                    assert_eq!(fv[(k + 1) % 4], a);
+                }
+            }
+            for v in 0..child.vertex_count() {
+                assert_eq!(
+                    child.is_boundary_vertex(v),
+                    rebuilt.is_boundary_vertex(v),
+                    "{v}"
+                );
+                let mut f1 = child.vertex_faces(v).to_vec();
+                let f2 = rebuilt.vertex_faces(v).to_vec();
+                // Same cyclic order, possibly rotated for interior vertices.
+                if !child.is_boundary_vertex(v) {
+                    let k = f1.iter().position(|&f| f == f2[0]).unwrap();
+                    f1.rotate_left(k);
+                }
+                assert_eq!(f1, f2, "ring of {v}");
+                for (&f, &c) in child
+                    .vertex_faces(v)
+                    .iter()
+                    .zip(child.vertex_face_corners(v))
+                {
+                    assert_eq!(child.face_vertices(f as usize)[c as usize], v as u32);
+                }
+                let edges = child.vertex_edges(v);
+                for (k, &f) in child.vertex_faces(v).iter().enumerate() {
+                    let fe = child.face_edges(f as usize);
+                    assert!(fe.contains(&edges[k]) && fe.contains(&edges[(k + 1) % edges.len()]));
+                }
             }
         }
     }

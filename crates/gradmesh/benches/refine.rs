@@ -1,0 +1,80 @@
+//! Benchmarks of the refinement stages: validation and base level, the ternary step, a
+//! Catmull-Clark step (topology and stencils), data evaluation, and limit stencils.
+//!
+//! Run: `cargo bench -p gradmesh --bench refine`.
+
+#![allow(missing_docs)] // criterion_group! generates undocumented items.
+
+use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use gradmesh::catmull_clark;
+use gradmesh::limit::limit_stencils;
+use gradmesh::refine::Refinement;
+use gradmesh::ternary_step::{ternary_data, ternary_level};
+use gradmesh::validate::BaseMesh;
+use gradmesh::{ColourSpace, GradientMesh};
+use kurbo::Point;
+
+/// A jittered grid of `n` x `n` cells, every third cell split into two triangles: about
+/// 1.33 n^2 faces of mixed sizes.
+fn mesh(n: u32) -> GradientMesh {
+    let mut m = GradientMesh::new(ColourSpace::Lab);
+    for j in 0..=n {
+        for i in 0..=n {
+            let jitter = ((i * 7 + j * 13) % 10) as f64 * 0.02;
+            m.add_point(
+                Point::new(i as f64 + jitter, j as f64 - jitter),
+                [(i % 100) as f64, (j % 50) as f64, 0.0],
+            );
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            let v = j * (n + 1) + i;
+            let (a, b, c, d) = (v, v + 1, v + n + 2, v + n + 1);
+            if (i + j) % 3 == 0 {
+                m.add_face(vec![a, b, c]);
+                m.add_face(vec![a, c, d]);
+            } else {
+                m.add_face(vec![a, b, c, d]);
+            }
+        }
+    }
+    m
+}
+
+fn bench(c: &mut Criterion) {
+    let m = mesh(87); // 10,092 faces
+    assert!(m.faces.len() >= 10_000);
+    let (base, _) = BaseMesh::new(&m).unwrap();
+    let level1 = ternary_level(&base);
+    let data1 = ternary_data(&base);
+    let (level2, stencils) = catmull_clark::refine(&level1);
+
+    let mut g = c.benchmark_group("10k_faces");
+    g.sample_size(20);
+    g.bench_function("validate_and_base_level", |b| {
+        b.iter(|| BaseMesh::new(black_box(&m)).unwrap())
+    });
+    g.bench_function("ternary_step_topology", |b| {
+        b.iter(|| ternary_level(black_box(&base)))
+    });
+    g.bench_function("ternary_step_data", |b| {
+        b.iter(|| ternary_data(black_box(&base)))
+    });
+    g.bench_function("ternary_step_and_setup", |b| {
+        b.iter(|| Refinement::new(black_box(&m), 1).unwrap())
+    });
+    g.bench_function("catmull_clark_topology_and_stencils", |b| {
+        b.iter(|| catmull_clark::refine(black_box(&level1)))
+    });
+    g.bench_function("catmull_clark_data", |b| {
+        b.iter(|| stencils.apply(black_box(&data1)))
+    });
+    g.bench_function("limit_stencils", |b| {
+        b.iter(|| limit_stencils(black_box(&level2)).unwrap())
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
