@@ -1,5 +1,21 @@
-//! The `gradmesh` command.
+//! The `gradmesh` command: inspect, convert, refine and render gradient meshes.
+//!
+//! Flags are parsed in `args`; each subcommand in `commands` turns them into library calls.
 
-fn main() {
-    println!("gradmesh {}", env!("CARGO_PKG_VERSION"));
+mod args;
+mod commands;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+fn main() -> ExitCode {
+    let cli = args::Cli::parse();
+    match commands::run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("gradmesh: error: {e}");
+            ExitCode::FAILURE
+        }
+    }
 }

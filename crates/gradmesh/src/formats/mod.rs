@@ -1,1 +1,281 @@
 //! Reading and writing gradient meshes: the native JSON format, the authors' OFF, and OBJ.
+//!
+//! The native format is specified in `docs/format.md`. Every reader reports errors with the line
+//! they occur on, and refuses input beyond the limits below before allocating for it.
+
+pub mod json;
+pub mod obj;
+pub mod off;
+
+use std::fs;
+use std::io::{Read, Write};
+use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use crate::error::{Error, ErrorKind, Location};
+use crate::mesh::{Document, GradientMesh};
+
+/// The largest input accepted, in bytes (256 MiB).
+pub const MAX_INPUT_BYTES: u64 = 256 * 1024 * 1024;
+
+/// The most control points one mesh may have.
+pub const MAX_POINTS: u64 = 1 << 24;
+
+/// The most faces one mesh may have.
+pub const MAX_FACES: u64 = 1 << 24;
+
+/// A file format, known by its extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Format {
+    /// The native JSON format (`.json`), read and written.
+    Json,
+    /// The paper authors' extended OFF (`.off`), read only.
+    Off,
+    /// Wavefront OBJ polygon meshes (`.obj`), read; refined meshes are written.
+    Obj,
+}
+
+impl Format {
+    /// Every format.
+    pub const ALL: [Format; 3] = [Format::Json, Format::Off, Format::Obj];
+
+    /// The format of a path, from its extension (case-insensitive).
+    pub fn from_path(path: &Path) -> Option<Format> {
+        Format::from_extension(path.extension()?.to_str()?)
+    }
+
+    /// The format with extension `ext` (without the dot, case-insensitive).
+    pub fn from_extension(ext: &str) -> Option<Format> {
+        Format::ALL
+            .into_iter()
+            .find(|f| f.extension().eq_ignore_ascii_case(ext))
+    }
+
+    /// The usual extension, without the dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Format::Json => "json",
+            Format::Off => "off",
+            Format::Obj => "obj",
+        }
+    }
+}
+
+/// Reads a document from text in the given format. OFF and OBJ files give one unnamed layer.
+pub fn read_str(text: &str, format: Format) -> Result<Document, Error> {
+    match format {
+        Format::Json => json::read_document(text),
+        Format::Off => off::read_off(text).map(single_layer),
+        Format::Obj => obj::read_obj(text).map(single_layer),
+    }
+}
+
+/// Reads a document from a file, choosing the format by the extension. OFF and OBJ files give one
+/// layer named after the file stem. Every error is located in the file.
+pub fn read_path(path: &Path) -> Result<Document, Error> {
+    read_path_unlocated(path).map_err(|e| e.in_file(path))
+}
+
+fn read_path_unlocated(path: &Path) -> Result<Document, Error> {
+    let format = Format::from_path(path).ok_or_else(|| {
+        let found = match path.extension() {
+            Some(ext) => format!("the extension \".{}\"", ext.to_string_lossy()),
+            None => "no extension".to_string(),
+        };
+        Error::new(ErrorKind::Io(format!(
+            "cannot tell the format from {found}: expected .json, .off or .obj"
+        )))
+    })?;
+    let text = read_text(path)?;
+    let mut doc = read_str(&text, format)?;
+    if format != Format::Json {
+        if let Some(stem) = path.file_stem() {
+            for layer in &mut doc.layers {
+                layer.name = Some(stem.to_string_lossy().into_owned());
+            }
+        }
+    }
+    Ok(doc)
+}
+
+/// Reads a whole UTF-8 file, refusing one larger than [`MAX_INPUT_BYTES`].
+fn read_text(path: &Path) -> Result<String, Error> {
+    let io = |e: std::io::Error| Error::new(ErrorKind::Io(format!("cannot read the file: {e}")));
+    let file = fs::File::open(path).map_err(io)?;
+    let declared = file.metadata().map_err(io)?.len();
+    check_size(declared)?;
+    let mut bytes = Vec::with_capacity(declared as usize);
+    // One byte more than the limit, in case the file grew since its size was read.
+    file.take(MAX_INPUT_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    check_size(bytes.len() as u64)?;
+    String::from_utf8(bytes).map_err(|e| {
+        let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+        let line = 1 + valid.iter().filter(|&&b| b == b'\n').count();
+        Error {
+            location: Location::default().at_line(line),
+            kind: ErrorKind::Syntax("the file is not UTF-8 text".into()),
+        }
+    })
+}
+
+/// Refuses an input of `len` bytes above [`MAX_INPUT_BYTES`].
+pub(crate) fn check_size(len: u64) -> Result<(), Error> {
+    if len > MAX_INPUT_BYTES {
+        return Err(ErrorKind::LimitExceeded {
+            what: "the input size in bytes".into(),
+            found: len,
+            limit: MAX_INPUT_BYTES,
+        }
+        .into());
+    }
+    Ok(())
+}
+
+/// Refuses a count of `what` above `limit`.
+pub(crate) fn check_count(what: &str, found: u64, limit: u64) -> Result<(), Error> {
+    if found > limit {
+        return Err(ErrorKind::LimitExceeded {
+            what: what.into(),
+            found,
+            limit,
+        }
+        .into());
+    }
+    Ok(())
+}
+
+/// A syntax error at a line.
+pub(crate) fn syntax_error(line: usize, message: impl Into<String>) -> Error {
+    Error::syntax(&Location::default(), line, message)
+}
+
+/// A located error of another kind.
+pub(crate) fn error_at(line: usize, kind: ErrorKind) -> Error {
+    Error {
+        location: Location::default().at_line(line),
+        kind,
+    }
+}
+
+fn single_layer(mesh: GradientMesh) -> Document {
+    Document { layers: vec![mesh] }
+}
+
+/// Distinguishes the temporary files of one process.
+static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// Writes `bytes` to `path` atomically: into a new temporary file in the same directory, flushed
+/// to disk, then renamed over `path`. If anything fails, the temporary file is removed and an
+/// existing file at `path` is left as it was; a reader never sees a partly written file.
+///
+/// An existing file's permissions are kept. The error is located in `path`.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    let fail = |what: &str, e: std::io::Error| {
+        Error::new(ErrorKind::Io(format!("cannot {what}: {e}"))).in_file(path)
+    };
+    let name = path.file_name().ok_or_else(|| {
+        Error::new(ErrorKind::Io("the output path names no file".into())).in_file(path)
+    })?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let permissions = fs::metadata(path).ok().map(|m| m.permissions());
+
+    let (temp_path, mut file) = loop {
+        let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
+        let temp_name = format!(".{}.tmp-{}-{n}", name.to_string_lossy(), std::process::id());
+        let candidate = dir.join(temp_name);
+        match fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&candidate)
+        {
+            Ok(f) => break (candidate, f),
+            // Left over by a crashed run with the same process id: take the next name.
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && n < 1 << 20 => continue,
+            Err(e) => return Err(fail("create a temporary file", e)),
+        }
+    };
+    let result = (|| {
+        file.write_all(bytes).map_err(|e| fail("write", e))?;
+        if let Some(p) = permissions {
+            file.set_permissions(p)
+                .map_err(|e| fail("set permissions", e))?;
+        }
+        file.sync_all().map_err(|e| fail("flush to disk", e))?;
+        drop(file);
+        fs::rename(&temp_path, path).map_err(|e| fail("replace the file", e))
+    })();
+    if result.is_err() {
+        let _ = fs::remove_file(&temp_path);
+        return result;
+    }
+    // Make the rename itself durable where directories can be synced; best effort.
+    if let Ok(d) = fs::File::open(dir) {
+        let _ = d.sync_all();
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn formats_from_paths() {
+        assert_eq!(Format::from_path(Path::new("a/b.json")), Some(Format::Json));
+        assert_eq!(Format::from_path(Path::new("B.OFF")), Some(Format::Off));
+        assert_eq!(Format::from_path(Path::new("x.Obj")), Some(Format::Obj));
+        assert_eq!(Format::from_path(Path::new("x.svg")), None);
+        assert_eq!(Format::from_path(Path::new("json")), None);
+    }
+
+    #[test]
+    fn unknown_extension_is_named() {
+        let e = read_path(Path::new("/nonexistent/picture.svg")).unwrap_err();
+        let text = e.to_string();
+        assert!(
+            text.contains("\".svg\"") && text.contains("picture.svg"),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn missing_file_is_located() {
+        let e = read_path(Path::new("/nonexistent/picture.json")).unwrap_err();
+        assert_eq!(
+            e.location.file.as_deref(),
+            Some(Path::new("/nonexistent/picture.json"))
+        );
+        assert!(matches!(e.kind, ErrorKind::Io(_)));
+    }
+
+    #[test]
+    fn atomic_write_replaces_and_leaves_no_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.json");
+        write_atomic(&path, b"first").unwrap();
+        write_atomic(&path, b"second").unwrap();
+        assert_eq!(fs::read(&path).unwrap(), b"second");
+        let names: Vec<_> = fs::read_dir(dir.path()).unwrap().collect();
+        assert_eq!(names.len(), 1);
+    }
+
+    #[test]
+    fn failed_atomic_write_keeps_the_old_file() {
+        let dir = tempfile::tempdir().unwrap();
+        // Renaming a file over a non-empty directory fails after the data was written.
+        let target = dir.path().join("taken");
+        fs::create_dir(&target).unwrap();
+        fs::write(target.join("inside"), b"keep").unwrap();
+        assert!(write_atomic(&target, b"new").is_err());
+        assert_eq!(fs::read(target.join("inside")).unwrap(), b"keep");
+        let names: Vec<_> = fs::read_dir(dir.path()).unwrap().collect();
+        assert_eq!(names.len(), 1, "the temporary file was not removed");
+        // A directory that does not exist: nothing is created.
+        assert!(write_atomic(&dir.path().join("no/such/dir.json"), b"x").is_err());
+    }
+}

@@ -1,0 +1,23 @@
+//! `gradmesh convert`: any input to the native JSON format.
+
+use gradmesh::formats::{self, Format};
+use gradmesh::{Error, ErrorKind};
+
+use crate::args::ConvertArgs;
+
+pub fn run(args: &ConvertArgs) -> Result<(), Error> {
+    if Format::from_path(&args.output) != Some(Format::Json) {
+        return Err(Error::new(ErrorKind::Io(format!(
+            "{}: convert writes the native format; give the output a .json extension",
+            args.output.display()
+        ))));
+    }
+    super::check_not_input(&args.output, &[&args.input], args.force)?;
+    let doc = super::read(&args.input)?;
+    for (i, mesh) in doc.layers.iter().enumerate() {
+        let warnings = gradmesh::validate(mesh).map_err(|e| e.in_layer(i).in_file(&args.input))?;
+        super::print_warnings(&args.input, &warnings);
+    }
+    let text = formats::json::write_document(&doc);
+    formats::write_atomic(&args.output, text.as_bytes())
+}

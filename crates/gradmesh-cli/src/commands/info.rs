@@ -1,0 +1,134 @@
+//! `gradmesh info`: what a mesh is made of.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use gradmesh::topology::Topology;
+use gradmesh::validate::BaseMesh;
+use gradmesh::{EdgeKind, Error, GradientMesh};
+
+use crate::args::InfoArgs;
+
+pub fn run(args: &InfoArgs) -> Result<(), Error> {
+    let mut failed = None;
+    for path in &args.inputs {
+        match super::read(path) {
+            Ok(doc) => {
+                println!("{}", path.display());
+                for (i, mesh) in doc.layers.iter().enumerate() {
+                    match describe(mesh) {
+                        Ok((text, warnings)) => {
+                            print!("  layer {i}{text}");
+                            for w in warnings {
+                                println!("    warning: {w}");
+                            }
+                        }
+                        Err(e) => {
+                            let e = e.in_layer(i).in_file(path);
+                            eprintln!("gradmesh: error: {e}");
+                            failed = Some(e);
+                        }
+                    }
+                }
+            }
+            Err(e) => {
+                eprintln!("gradmesh: error: {e}");
+                failed = Some(e);
+            }
+        }
+    }
+    // Every file was reported; fail if any could not be read.
+    match failed {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+fn histogram(values: impl Iterator<Item = usize>) -> String {
+    let mut h = BTreeMap::new();
+    for v in values {
+        *h.entry(v).or_insert(0usize) += 1;
+    }
+    h.iter()
+        .map(|(k, n)| format!("{k}: {n}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+fn describe(mesh: &GradientMesh) -> Result<(String, Vec<gradmesh::Warning>), Error> {
+    let (base, warnings) = BaseMesh::new(mesh)?;
+    let whole = Topology::from_faces(mesh.points.len(), &mesh.faces)?;
+    let mut s = String::new();
+    if let Some(name) = &mesh.name {
+        write!(s, " \"{name}\"").unwrap();
+    }
+    writeln!(
+        s,
+        ": colour space {}, boundary {}, creasing {}",
+        mesh.colour_space.name(),
+        mesh.boundary.name(),
+        mesh.creasing.name()
+    )
+    .unwrap();
+    writeln!(
+        s,
+        "    points {}, faces {}, edges {}, corners {}",
+        mesh.points.len(),
+        mesh.faces.len(),
+        whole.edge_count(),
+        mesh.corner_count()
+    )
+    .unwrap();
+    let boundary_edges = (0..whole.edge_count())
+        .filter(|&e| whole.is_boundary_edge(e))
+        .count();
+    writeln!(
+        s,
+        "    boundary edges {boundary_edges}, Euler characteristic {}",
+        whole.euler_characteristic()
+    )
+    .unwrap();
+    writeln!(
+        s,
+        "    face sizes {{{}}}",
+        histogram(mesh.faces.iter().map(Vec::len))
+    )
+    .unwrap();
+    writeln!(
+        s,
+        "    valences {{{}}}",
+        histogram(
+            (0..whole.vertex_count())
+                .filter(|&v| !whole.vertex_faces(v).is_empty())
+                .map(|v| whole.vertex_edges(v).len())
+        )
+    )
+    .unwrap();
+    let count = |k: EdgeKind| mesh.edges.values().filter(|t| t.kind == k).count();
+    writeln!(
+        s,
+        "    creases {}, discontinuous edges {}, corner points {}, split points {}",
+        count(EdgeKind::Crease),
+        count(EdgeKind::Discontinuous),
+        mesh.points.iter().filter(|p| p.corner).count(),
+        base.source_point.len() - mesh.points.len()
+    )
+    .unwrap();
+    if let Some(b) = bounds(mesh) {
+        writeln!(
+            s,
+            "    bounds x {} .. {}, y {} .. {}",
+            b[0], b[2], b[1], b[3]
+        )
+        .unwrap();
+    }
+    Ok((s, warnings))
+}
+
+fn bounds(mesh: &GradientMesh) -> Option<[f64; 4]> {
+    let mut it = mesh.points.iter().map(|p| p.position);
+    let first = it.next()?;
+    Some(it.fold([first.x, first.y, first.x, first.y], |b, p| {
+        [b[0].min(p.x), b[1].min(p.y), b[2].max(p.x), b[3].max(p.y)]
+    }))
+}

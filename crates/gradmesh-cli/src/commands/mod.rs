@@ -1,0 +1,50 @@
+//! The subcommands, each turning parsed flags into library calls.
+
+mod convert;
+mod info;
+mod refine;
+
+use std::path::Path;
+
+use gradmesh::{Document, Error};
+
+use crate::args::{Cli, Command};
+
+/// Runs the subcommand of `cli`.
+pub fn run(cli: Cli) -> Result<(), Error> {
+    match cli.command {
+        Command::Info(a) => info::run(&a),
+        Command::Convert(a) => convert::run(&a),
+        Command::Refine(a) => refine::run(&a),
+    }
+}
+
+/// Reads a document, with errors located in the file.
+fn read(path: &Path) -> Result<Document, Error> {
+    gradmesh::formats::read_path(path)
+}
+
+/// Refuses to write over an input unless `force` is given.
+fn check_not_input(output: &Path, inputs: &[&Path], force: bool) -> Result<(), Error> {
+    if force {
+        return Ok(());
+    }
+    let canon = |p: &Path| std::fs::canonicalize(p).ok();
+    let out = canon(output);
+    for input in inputs {
+        if out.is_some() && out == canon(input) {
+            return Err(Error::new(gradmesh::ErrorKind::Io(format!(
+                "{} is also the input; pass --force to write over it",
+                output.display()
+            ))));
+        }
+    }
+    Ok(())
+}
+
+/// Prints warnings to standard error.
+fn print_warnings(path: &Path, warnings: &[gradmesh::Warning]) {
+    for w in warnings {
+        eprintln!("gradmesh: warning: {}: {w}", path.display());
+    }
+}

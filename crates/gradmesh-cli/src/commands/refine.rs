@@ -1,0 +1,65 @@
+//! `gradmesh refine`: the refined control mesh, or its limit points, at a level.
+
+use gradmesh::formats::{self, Format};
+use gradmesh::refine::Refinement;
+use gradmesh::{Error, ErrorKind};
+
+use crate::args::RefineArgs;
+
+pub fn run(args: &RefineArgs) -> Result<(), Error> {
+    let format = Format::from_path(&args.output)
+        .filter(|f| matches!(f, Format::Obj | Format::Json))
+        .ok_or_else(|| {
+            Error::new(ErrorKind::Io(format!(
+                "{}: refine writes .obj or .json",
+                args.output.display()
+            )))
+        })?;
+    super::check_not_input(&args.output, &[&args.input], args.force)?;
+    let doc = super::read(&args.input)?;
+    let mut layers = Vec::with_capacity(doc.layers.len());
+    for (i, mesh) in doc.layers.iter().enumerate() {
+        let locate = |e: Error| e.in_layer(i).in_file(&args.input);
+        let (mut refinement, warnings) = Refinement::new(mesh, args.levels).map_err(locate)?;
+        super::print_warnings(&args.input, &warnings);
+        let data = refinement.evaluate();
+        let points = if args.limit {
+            refinement.limit(&data, args.levels)
+        } else {
+            data.levels[args.levels].clone()
+        };
+        layers.push((refinement, points));
+    }
+    let text = match format {
+        Format::Obj => {
+            let parts: Vec<_> = doc
+                .layers
+                .iter()
+                .zip(&layers)
+                .map(|(mesh, (r, points))| {
+                    (
+                        mesh.name.as_deref(),
+                        r.topology(args.levels),
+                        points.as_slice(),
+                    )
+                })
+                .collect();
+            formats::obj::write_refined_obj(&parts)
+        }
+        _ => {
+            let parts: Vec<_> = doc
+                .layers
+                .iter()
+                .zip(&layers)
+                .map(|(mesh, (r, points))| formats::json::RefinedLayer {
+                    name: mesh.name.as_deref(),
+                    colour_space: mesh.colour_space,
+                    topology: r.topology(args.levels),
+                    data: points,
+                })
+                .collect();
+            formats::json::write_refined(&parts)
+        }
+    };
+    formats::write_atomic(&args.output, text.as_bytes())
+}

@@ -1,0 +1,207 @@
+//! The `gradmesh` binary, run for real in temporary directories.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn realdata() -> PathBuf {
+    PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/realdata/gradientmeshimproved-off"
+    ))
+}
+
+fn real_files() -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(realdata())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "off"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 11, "{files:?}");
+    files
+}
+
+fn gradmesh(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_gradmesh"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn info_works_on_every_real_file() {
+    let files = real_files();
+    let args: Vec<&str> = std::iter::once("info")
+        .chain(files.iter().map(|p| s(p)))
+        .collect();
+    let out = gradmesh(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(text.matches("colour space lab").count(), files.len());
+    assert!(
+        text.contains("points 129, faces 102"),
+        "Glasses.off: {text}"
+    );
+    assert!(text.contains("face sizes {"));
+    assert!(text.contains("valences {"));
+    assert!(text.contains("bounds x "));
+}
+
+/// Counts `v` and `f` lines of an OBJ file.
+fn obj_counts(path: &Path) -> (usize, usize) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let v = text.lines().filter(|l| l.starts_with("v ")).count();
+    let f = text.lines().filter(|l| l.starts_with("f ")).count();
+    (v, f)
+}
+
+#[test]
+fn refine_works_on_every_real_file() {
+    let dir = tempfile::tempdir().unwrap();
+    for file in real_files() {
+        let mut last = (0, 0);
+        for level in 0..=3 {
+            let out = dir.path().join(format!("level{level}.obj"));
+            let o = gradmesh(&[
+                "refine",
+                s(&file),
+                "-o",
+                s(&out),
+                "--levels",
+                &level.to_string(),
+            ]);
+            assert!(o.status.success(), "{}: {}", file.display(), stderr(&o));
+            let counts = obj_counts(&out);
+            assert!(
+                counts.0 > last.0 && counts.1 > last.1,
+                "{}: {counts:?}",
+                file.display()
+            );
+            if level >= 2 {
+                // Each Catmull-Clark step turns every face into quads, one per corner.
+                let text = std::fs::read_to_string(&out).unwrap();
+                assert!(text
+                    .lines()
+                    .filter(|l| l.starts_with("f "))
+                    .all(|l| l.split_whitespace().count() == 5));
+            }
+            last = counts;
+        }
+        let json = dir.path().join("limit.json");
+        let o = gradmesh(&[
+            "refine",
+            s(&file),
+            "-o",
+            s(&json),
+            "--levels",
+            "2",
+            "--limit",
+        ]);
+        assert!(o.status.success(), "{}: {}", file.display(), stderr(&o));
+        let text = std::fs::read_to_string(&json).unwrap();
+        assert!(text.starts_with('{'));
+    }
+}
+
+#[test]
+fn refine_obj_vertices_carry_position_and_colour() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.obj");
+    let file = realdata().join("Tucan_Tucan_Layer0.off");
+    let o = gradmesh(&["refine", s(&file), "-o", s(&out), "--levels", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let v: Vec<&str> = text.lines().filter(|l| l.starts_with("v ")).collect();
+    // The reference output of the authors' tool has 88 points after the ternary step.
+    assert_eq!(v.len(), 88);
+    for line in v {
+        let fields: Vec<f64> = line[2..]
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
+        assert_eq!(fields.len(), 6, "{line}");
+        assert_eq!(fields[2], 0.0);
+        assert!((0.0..=100.0).contains(&fields[3]), "L in 0..100: {line}");
+    }
+}
+
+#[test]
+fn a_failed_run_leaves_the_existing_output_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.obj");
+    std::fs::write(&out, "precious").unwrap();
+    let bad = dir.path().join("bad.off");
+    std::fs::write(&bad, "OFF\n3 1 0\n0 0 1 50 0 0 0 0\n").unwrap();
+    let o = gradmesh(&["refine", s(&bad), "-o", s(&out)]);
+    assert!(!o.status.success());
+    let msg = stderr(&o);
+    assert!(msg.contains("bad.off"), "the message names the file: {msg}");
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "precious");
+    // No temporary file is left behind.
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), 2, "{names:?}");
+}
+
+#[test]
+fn convert_never_writes_over_its_input_unless_forced() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("glasses.json");
+    let o = gradmesh(&[
+        "convert",
+        s(&realdata().join("Glasses.off")),
+        "-o",
+        s(&json),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let before = std::fs::read(&json).unwrap();
+    let o = gradmesh(&["convert", s(&json), "-o", s(&json)]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("--force"), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&json).unwrap(), before);
+    // Read and written again, a native document is byte-identical.
+    let o = gradmesh(&["convert", s(&json), "-o", s(&json), "--force"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read(&json).unwrap(), before);
+    // And it refines like the original.
+    let (a, b) = (dir.path().join("a.obj"), dir.path().join("b.obj"));
+    assert!(
+        gradmesh(&["refine", s(&json), "-o", s(&a), "--levels", "2"])
+            .status
+            .success()
+    );
+    let off = realdata().join("Glasses.off");
+    assert!(gradmesh(&["refine", s(&off), "-o", s(&b), "--levels", "2"])
+        .status
+        .success());
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+}
+
+#[test]
+fn errors_name_the_file_and_the_element() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("bowtie.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\nf 1 4 5\n",
+    )
+    .unwrap();
+    let o = gradmesh(&["info", s(&obj)]);
+    assert!(!o.status.success());
+    let msg = stderr(&o);
+    assert!(msg.contains("bowtie.obj"), "{msg}");
+    assert!(msg.contains("point 0 is non-manifold"), "{msg}");
+    let o = gradmesh(&["refine", s(&obj), "-o", s(&dir.path().join("x.png"))]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains(".obj or .json"), "{}", stderr(&o));
+}
