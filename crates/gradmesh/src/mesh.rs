@@ -164,6 +164,9 @@ pub struct GradientMesh {
     pub boundary: BoundaryInterpolation,
     /// Sharpness subdivision rule for semi-sharp creases.
     pub creasing: CreasingMethod,
+    /// Move each control point's vertex after the ternary step so that the limit surface
+    /// passes through the control point (paper section 4.5). Off by default, as in the paper.
+    pub interpolate_positions: bool,
     /// The control points.
     pub points: Vec<ControlPoint>,
     /// Faces as loops of point indices, all wound the same way.
@@ -184,6 +187,7 @@ impl Default for GradientMesh {
             colour_space: ColourSpace::Lab,
             boundary: BoundaryInterpolation::EdgeAndCorner,
             creasing: CreasingMethod::Uniform,
+            interpolate_positions: false,
             points: Vec::new(),
             faces: Vec::new(),
             handles: BTreeMap::new(),

@@ -9,6 +9,7 @@ use crate::catmull_clark::{self, Level, Stencils};
 use crate::error::{Error, Warning};
 use crate::limit;
 use crate::mesh::GradientMesh;
+use crate::rules;
 use crate::ternary_step;
 use crate::topology::Topology;
 use crate::validate::{BaseMesh, VertexData};
@@ -21,6 +22,9 @@ pub struct Refinement {
     levels: Vec<Level>,
     /// `stencils[k - 1]` computes level `k + 1` from level `k`.
     stencils: Vec<Stencils>,
+    /// With interpolated positions: the level at which limit stencils are exact (every
+    /// semi-sharp feature has decayed), and those stencils.
+    interpolation: Option<(usize, Stencils)>,
 }
 
 /// The data (positions, colours, opacity) of every level of a [`Refinement`].
@@ -43,8 +47,21 @@ impl Refinement {
             base,
             levels: Vec::new(),
             stencils: Vec::new(),
+            interpolation: None,
         };
         r.extend_to(depth);
+        if r.base.interpolate_positions {
+            // Limit stencils are exact once no semi-sharp feature is left (sharpness 10 is
+            // infinite, so at most ten levels).
+            let mut d = 2;
+            r.extend_to(d);
+            while d < 12 && has_semi_sharp(r.level(d)) {
+                d += 1;
+                r.extend_to(d);
+            }
+            let limit = limit::limit_stencils(r.level(d)).expect("level 2 and below are quads");
+            r.interpolation = Some((d, limit));
+        }
         r
     }
 
@@ -110,7 +127,11 @@ impl Refinement {
     pub fn evaluate_with(&self, base: &BaseMesh) -> RefinedMesh {
         let mut levels = vec![base.data.clone()];
         if !self.levels.is_empty() {
-            levels.push(ternary_step::ternary_data(base));
+            let mut level1 = ternary_step::ternary_data(base);
+            if let Some((d, limit)) = &self.interpolation {
+                self.interpolate_positions(base, *d, limit, &mut level1);
+            }
+            levels.push(level1);
         }
         for st in &self.stencils {
             let next = st.apply(levels.last().expect("level 1"));
@@ -144,6 +165,48 @@ impl Refinement {
         }
     }
 
+    /// Moves the vertex point of every control point at level 1 so that its limit position is
+    /// the control point (paper section 4.5, after Loop et al.). A vertex point's limit depends
+    /// on its own position with a fixed weight `w` and on its ring, which holds no other vertex
+    /// point; so moving every vertex point by one unit at once reveals each `w`, and one
+    /// correction `(target - limit) / w` per point is exact: no global system.
+    fn interpolate_positions(
+        &self,
+        base: &BaseMesh,
+        depth: usize,
+        limit: &Stencils,
+        level1: &mut [VertexData],
+    ) {
+        let n = base.topology.vertex_count();
+        let limit_positions = |data: &[VertexData]| -> Vec<[f64; 2]> {
+            let mut d = data.to_vec();
+            for k in 1..depth {
+                d = self.stencils(k).apply(&d);
+            }
+            (0..n as u32)
+                .map(|v| {
+                    let (src, w) = limit.stencil(self.vertex_at_level(v, depth));
+                    src.iter().zip(w).fold([0.0; 2], |acc, (&s, &w)| {
+                        [acc[0] + w * d[s as usize][0], acc[1] + w * d[s as usize][1]]
+                    })
+                })
+                .collect()
+        };
+        let before = limit_positions(level1);
+        let mut shifted = level1.to_vec();
+        for d in &mut shifted[..n] {
+            d[0] += 1.0;
+            d[1] += 1.0;
+        }
+        let after = limit_positions(&shifted);
+        for v in 0..n {
+            for c in 0..2 {
+                let weight = after[v][c] - before[v][c];
+                level1[v][c] += (base.data[v][c] - before[v][c]) / weight;
+            }
+        }
+    }
+
     /// The data at level `j`, computing levels beyond those in `data` when needed.
     fn level_data(&self, data: &RefinedMesh, j: usize) -> Vec<VertexData> {
         if let Some(d) = data.levels.get(j) {
@@ -161,4 +224,10 @@ impl Refinement {
         }
         d
     }
+}
+
+/// Whether a level still has a semi-sharp (finite, non-zero) edge or vertex.
+fn has_semi_sharp(level: &Level) -> bool {
+    let semi = |&s: &f64| rules::is_sharp(s) && !rules::is_infinite(s);
+    level.edge_sharpness.iter().any(semi) || level.vertex_sharpness.iter().any(semi)
 }

@@ -35,6 +35,8 @@ pub struct BaseMesh {
     pub boundary: BoundaryInterpolation,
     /// Creasing method.
     pub creasing: CreasingMethod,
+    /// Whether limit positions interpolate the control points.
+    pub interpolate_positions: bool,
 }
 
 fn not_finite(what: String, value: f64) -> Error {
@@ -309,6 +311,7 @@ impl BaseMesh {
                 vertex_sharpness,
                 boundary: mesh.boundary,
                 creasing: mesh.creasing,
+                interpolate_positions: mesh.interpolate_positions,
             },
             warnings,
         ))

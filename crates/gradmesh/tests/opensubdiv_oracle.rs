@@ -4,7 +4,10 @@
 //! infinitely sharp and semi-sharp creases, corners, and both boundary interpolations. The
 //! oracle's weights are f32, so values are compared at 1e-5 relative; vertices are matched by
 //! position since the two number them differently. Not compared: Chaikin creasing and interior
-//! valence-2 vertices, where the port is known to differ from OpenSubdiv.
+//! valence-2 vertices, where the port is known to differ from OpenSubdiv, and the limit points
+//! of darts: OpenSubdiv gives a dart the smooth limit mask, which is not the limit (it changes
+//! when computed one level deeper; `limit::tests::dart_mask_is_the_limit_of_refinement`), and
+//! gradmesh uses the exact mask.
 
 mod common;
 
@@ -12,6 +15,7 @@ use common::{build, mesh_spec};
 use gradmesh::catmull_clark::{self, Level};
 use gradmesh::limit::limit_stencils;
 use gradmesh::mesh::SHARPNESS_INFINITE;
+use gradmesh::rules::VertexRule;
 use gradmesh::validate::{BaseMesh, VertexData};
 use gradmesh::{BoundaryInterpolation, GradientMesh};
 use opensubdiv_rs::far::{
@@ -22,7 +26,7 @@ use proptest::prelude::*;
 
 const DEPTH: usize = 3;
 
-/// Ours: levels 0..=DEPTH and the limit of the last level.
+/// Ours: levels 0..=DEPTH and the limit of the last level, without its darts.
 fn ours(mesh: &GradientMesh) -> (Vec<Vec<VertexData>>, Vec<VertexData>) {
     let (base, _) = BaseMesh::new(mesh).unwrap();
     let mut level = Level::from_base(&base);
@@ -33,7 +37,11 @@ fn ours(mesh: &GradientMesh) -> (Vec<Vec<VertexData>>, Vec<VertexData>) {
         level = child;
     }
     let limit = limit_stencils(&level).unwrap().apply(data.last().unwrap());
-    (data, limit)
+    let not_darts = (0..limit.len())
+        .filter(|&v| level.vertex_rule(v) != VertexRule::Dart)
+        .map(|v| limit[v])
+        .collect();
+    (data, not_darts)
 }
 
 /// The oracle's levels 0..=DEPTH and the limit of the last level.
@@ -93,7 +101,7 @@ fn oracle(mesh: &GradientMesh) -> (Vec<Vec<VertexData>>, Vec<VertexData>) {
 /// Checks that every vertex of `a` has a vertex of `b` at the same position with the same
 /// data, at 1e-5 relative to the size of the values.
 fn same_points(a: &[VertexData], b: &[VertexData], what: &str) -> Result<(), TestCaseError> {
-    prop_assert_eq!(a.len(), b.len(), "{}: vertex count", what);
+    prop_assert!(a.len() <= b.len(), "{}: vertex count", what);
     let mut order: Vec<usize> = (0..b.len()).collect();
     order.sort_by(|&i, &j| b[i][0].total_cmp(&b[j][0]));
     let xs: Vec<f64> = order.iter().map(|&i| b[i][0]).collect();
@@ -133,6 +141,7 @@ proptest! {
         let (a, la) = ours(&mesh);
         let (b, lb) = oracle(&mesh);
         for k in 1..=DEPTH {
+            prop_assert_eq!(a[k].len(), b[k].len());
             same_points(&a[k], &b[k], &format!("level {k}"))?;
         }
         same_points(&la, &lb, "limit")?;

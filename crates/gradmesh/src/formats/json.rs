@@ -207,6 +207,8 @@ struct RawLayer {
     boundary: Option<String>,
     #[serde(default)]
     creasing: Option<String>,
+    #[serde(default)]
+    interpolate_positions: bool,
     points: Vec<RawPoint>,
     faces: Vec<Vec<Index>>,
     #[serde(default)]
@@ -746,6 +748,7 @@ fn convert_layer(text: &str, layer: usize, raw: RawLayer) -> Result<GradientMesh
         colour_space: reader.named("colour_space", raw.colour_space.as_deref(), &spaces)?,
         boundary: reader.named("boundary", raw.boundary.as_deref(), &boundaries)?,
         creasing: reader.named("creasing", raw.creasing.as_deref(), &creasings)?,
+        interpolate_positions: raw.interpolate_positions,
         points: Vec::with_capacity(raw.points.len()),
         faces: Vec::with_capacity(raw.faces.len()),
         ..GradientMesh::default()
@@ -1199,6 +1202,9 @@ fn write_layer(mesh: &GradientMesh, indent: usize) -> String {
     }
     if mesh.creasing != CreasingMethod::Uniform {
         fields.push(("creasing", string(mesh.creasing.name())));
+    }
+    if mesh.interpolate_positions {
+        fields.push(("interpolate_positions", "true".to_string()));
     }
     let points = mesh.points.iter().enumerate().map(|(p, cp)| {
         let p = p as u32;
