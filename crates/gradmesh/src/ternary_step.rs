@@ -9,7 +9,7 @@
 use kurbo::{Point, Vec2};
 
 use crate::catmull_clark::Level;
-use crate::topology::Topology;
+use crate::topology::{Topology, INVALID};
 use crate::validate::{BaseMesh, VertexData};
 
 /// Index of the vertex point of base vertex `v`.
@@ -41,59 +41,14 @@ pub fn first_child_face(base: &Topology, f: usize) -> usize {
 /// The level-1 topology and sharpness of `base`.
 pub fn ternary_level(base: &BaseMesh) -> Level {
     let t = &base.topology;
-    let nv1 = t.vertex_count() + 2 * t.edge_count() + t.corner_count();
-    let mut offsets = Vec::with_capacity(t.face_count() + 2 * t.corner_count() + 1);
-    let mut verts = Vec::with_capacity(9 * t.corner_count());
-    offsets.push(0u32);
-    for f in 0..t.face_count() {
-        let fv = t.face_vertices(f);
-        let fe = t.face_edges(f);
-        let o = t.face_offset(f);
-        let n = fv.len();
-        let ep = |i: usize, v: u32| edge_point(t, fe[i], end_of(t, fe[i], v));
-        verts.extend((0..n).map(|i| face_point(t, o + i)));
-        offsets.push(verts.len() as u32);
-        for i in 0..n {
-            let prev = (i + n - 1) % n;
-            verts.extend_from_slice(&[
-                vertex_point(fv[i]),
-                ep(i, fv[i]),
-                face_point(t, o + i),
-                ep(prev, fv[i]),
-            ]);
-            offsets.push(verts.len() as u32);
-        }
-        for i in 0..n {
-            let next = (i + 1) % n;
-            verts.extend_from_slice(&[
-                ep(i, fv[i]),
-                ep(i, fv[next]),
-                face_point(t, o + next),
-                face_point(t, o + i),
-            ]);
-            offsets.push(verts.len() as u32);
-        }
-    }
-    let topology =
-        Topology::build(nv1, offsets, verts, |_, _| false).expect("the ternary split is manifold");
-
-    // The three level-1 edges along a base edge inherit its sharpness.
+    let topology = ternary_topology(t);
+    // The three level-1 edges along a base edge (numbered 3e, 3e + 1, 3e + 2) inherit its
+    // sharpness; edges inside base faces are smooth.
     let mut edge_sharpness = vec![0.0; topology.edge_count()];
-    for f in 0..t.face_count() {
-        let fe = t.face_edges(f);
-        let n = fe.len();
-        let first = first_child_face(t, f);
-        for i in 0..n {
-            let s = base.edge_sharpness[fe[i] as usize];
-            let corner_quad = topology.face_edges(first + 1 + i);
-            let edge_quad = topology.face_edges(first + 1 + n + i);
-            let next_corner_quad = topology.face_edges(first + 1 + (i + 1) % n);
-            edge_sharpness[corner_quad[0] as usize] = s;
-            edge_sharpness[edge_quad[0] as usize] = s;
-            edge_sharpness[next_corner_quad[3] as usize] = s;
-        }
+    for (e, &s) in base.edge_sharpness.iter().enumerate() {
+        edge_sharpness[3 * e..3 * e + 3].fill(s);
     }
-    let mut vertex_sharpness = vec![0.0; nv1];
+    let mut vertex_sharpness = vec![0.0; topology.vertex_count()];
     vertex_sharpness[..t.vertex_count()].copy_from_slice(&base.vertex_sharpness);
     Level::new(
         topology,
@@ -101,6 +56,231 @@ pub fn ternary_level(base: &BaseMesh) -> Level {
         vertex_sharpness,
         base.creasing,
         base.boundary,
+    )
+}
+
+/// The topology of the ternary split of `t`, built directly (no search for twins).
+///
+/// Faces of base face `f` (offset `o`, `n` corners) start at `f + 2 o`: the central face, then
+/// the corner quad `Q(c)` of each corner `c`, then the edge quad `X(c)` of each corner (the quad
+/// along the edge leaving `c`). Edges: `3 e + k` joins the vertex point at end `k` of base edge
+/// `e` to the edge point there, `3 e + 2` joins the two edge points; for each base corner `c`,
+/// `3 E + 3 c` joins the edge point of the outgoing edge to the face point `FP(c)`, `+ 1` the
+/// edge point of the incoming edge to `FP(c)`, `+ 2` joins `FP(c)` to the next face point.
+pub fn ternary_topology(t: &Topology) -> Topology {
+    let (nf, ne, nv, nc) = (
+        t.face_count(),
+        t.edge_count(),
+        t.vertex_count(),
+        t.corner_count(),
+    );
+    let mut corner_face = vec![0u32; nc];
+    for f in 0..nf {
+        let o = t.face_offset(f);
+        corner_face[o..o + t.face_vertices(f).len()].fill(f as u32);
+    }
+    let face_range = |c: usize| {
+        let f = corner_face[c] as usize;
+        (f, t.face_offset(f), t.face_vertices(f).len())
+    };
+    let next = |c: usize| {
+        let (_, o, n) = face_range(c);
+        o + (c - o + 1) % n
+    };
+    let prev = |c: usize| {
+        let (_, o, n) = face_range(c);
+        o + (c - o + n - 1) % n
+    };
+    let corner_vertex = |c: usize| {
+        t.face_vertices(corner_face[c] as usize)[c - t.face_offset(corner_face[c] as usize)]
+    };
+    let corner_edge = |c: usize| {
+        t.face_edges(corner_face[c] as usize)[c - t.face_offset(corner_face[c] as usize)]
+    };
+    let end_at = |e: u32, v: u32| usize::from(t.edge_vertices(e as usize)[0] != v);
+
+    let ep = |e: u32, k: usize| (nv + 2 * e as usize + k) as u32;
+    let fp = |c: usize| (nv + 2 * ne + c) as u32;
+    let central = |f: usize| (f + 2 * t.face_offset(f)) as u32;
+    let quad = |c: usize| {
+        let (f, o, _) = face_range(c);
+        (f + o + 1 + c) as u32
+    };
+    let side = |c: usize| {
+        let (f, o, n) = face_range(c);
+        (f + o + 1 + n + c) as u32
+    };
+    let along = |e: u32, k: usize| 3 * e + k as u32;
+    let middle = |e: u32| 3 * e + 2;
+    let out_spoke = |c: usize| (3 * ne + 3 * c) as u32;
+    let in_spoke = |c: usize| (3 * ne + 3 * c + 1) as u32;
+    let rim = |c: usize| (3 * ne + 3 * c + 2) as u32;
+    // Edge point of the outgoing and incoming edges at corner c, near c's vertex.
+    let ep_out = |c: usize| {
+        let e = corner_edge(c);
+        ep(e, end_at(e, corner_vertex(c)))
+    };
+    let ep_in = |c: usize| {
+        let e = corner_edge(prev(c));
+        ep(e, end_at(e, corner_vertex(c)))
+    };
+
+    let face_count = nf + 2 * nc;
+    let mut face_offsets = Vec::with_capacity(face_count + 1);
+    let mut face_verts = Vec::with_capacity(9 * nc);
+    let mut face_edges = Vec::with_capacity(9 * nc);
+    face_offsets.push(0u32);
+    for f in 0..nf {
+        let (o, n) = (t.face_offset(f), t.face_vertices(f).len());
+        for c in o..o + n {
+            face_verts.push(fp(c));
+            face_edges.push(rim(c));
+        }
+        face_offsets.push(face_verts.len() as u32);
+        for c in o..o + n {
+            let v = corner_vertex(c);
+            let (eo, ei) = (corner_edge(c), corner_edge(prev(c)));
+            face_verts.extend_from_slice(&[v, ep_out(c), fp(c), ep_in(c)]);
+            face_edges.extend_from_slice(&[
+                along(eo, end_at(eo, v)),
+                out_spoke(c),
+                in_spoke(c),
+                along(ei, end_at(ei, v)),
+            ]);
+            face_offsets.push(face_verts.len() as u32);
+        }
+        for c in o..o + n {
+            face_verts.extend_from_slice(&[ep_out(c), ep_in(next(c)), fp(next(c)), fp(c)]);
+            face_edges.extend_from_slice(&[
+                middle(corner_edge(c)),
+                in_spoke(next(c)),
+                rim(c),
+                out_spoke(c),
+            ]);
+            face_offsets.push(face_verts.len() as u32);
+        }
+    }
+
+    // The corner at which each base edge leaves its end 0 (first face) and end 1 (second face).
+    let mut leaving = vec![[INVALID; 2]; ne];
+    for c in 0..nc {
+        let e = corner_edge(c) as usize;
+        leaving[e][end_at(e as u32, corner_vertex(c))] = c as u32;
+    }
+    let or_invalid =
+        |c: u32, f: &dyn Fn(usize) -> u32| if c == INVALID { INVALID } else { f(c as usize) };
+
+    let mut edge_verts = Vec::with_capacity(3 * ne + 3 * nc);
+    let mut edge_faces = Vec::with_capacity(3 * ne + 3 * nc);
+    for e in 0..ne as u32 {
+        let [a, b] = t.edge_vertices(e as usize);
+        let [c0, c1] = leaving[e as usize];
+        edge_verts.push([a, ep(e, 0)]);
+        edge_faces.push([quad(c0 as usize), or_invalid(c1, &|c| quad(next(c)))]);
+        edge_verts.push([ep(e, 1), b]);
+        edge_faces.push([quad(next(c0 as usize)), or_invalid(c1, &quad)]);
+        edge_verts.push([ep(e, 0), ep(e, 1)]);
+        edge_faces.push([side(c0 as usize), or_invalid(c1, &side)]);
+    }
+    for c in 0..nc {
+        edge_verts.push([ep_out(c), fp(c)]);
+        edge_faces.push([quad(c), side(c)]);
+        edge_verts.push([ep_in(c), fp(c)]);
+        edge_faces.push([side(prev(c)), quad(c)]);
+        edge_verts.push([fp(c), fp(next(c))]);
+        edge_faces.push([central(corner_face[c] as usize), side(c)]);
+    }
+
+    let vertex_count = nv + 2 * ne + nc;
+    let mut ring_offsets = Vec::with_capacity(vertex_count + 1);
+    let mut ring_faces = Vec::with_capacity(9 * 4 * nc);
+    let mut ring_corners = Vec::with_capacity(9 * 4 * nc);
+    let mut edge_ring_offsets = Vec::with_capacity(vertex_count + 1);
+    let mut ring_edges = Vec::with_capacity(9 * 4 * nc + vertex_count);
+    ring_offsets.push(0u32);
+    edge_ring_offsets.push(0u32);
+    let mut push_ring = |faces: &[(u32, u32)], edges: &[u32]| {
+        for &(f, c) in faces {
+            ring_faces.push(f);
+            ring_corners.push(c);
+        }
+        ring_edges.extend_from_slice(edges);
+        ring_offsets.push(ring_faces.len() as u32);
+        edge_ring_offsets.push(ring_edges.len() as u32);
+    };
+    // Vertex points: the base ring, mapped onto the corner quads.
+    let mut faces = Vec::new();
+    let mut edges = Vec::new();
+    for v in 0..nv {
+        faces.clear();
+        edges.clear();
+        for (&f, &c) in t.vertex_faces(v).iter().zip(t.vertex_face_corners(v)) {
+            faces.push((quad(t.face_offset(f as usize) + c as usize), 0));
+        }
+        for &e in t.vertex_edges(v) {
+            edges.push(along(e, end_at(e, v as u32)));
+        }
+        push_ring(&faces, &edges);
+    }
+    // Edge points, near end 0 then near end 1 of each base edge.
+    for e in 0..ne as u32 {
+        let [c0, c1] = leaving[e as usize].map(|c| c as usize);
+        if leaving[e as usize][1] == INVALID {
+            push_ring(
+                &[(quad(c0), 1), (side(c0), 0)],
+                &[along(e, 0), out_spoke(c0), middle(e)],
+            );
+            push_ring(
+                &[(side(c0), 1), (quad(next(c0)), 3)],
+                &[middle(e), in_spoke(next(c0)), along(e, 1)],
+            );
+        } else {
+            push_ring(
+                &[
+                    (quad(c0), 1),
+                    (side(c0), 0),
+                    (side(c1), 1),
+                    (quad(next(c1)), 3),
+                ],
+                &[along(e, 0), out_spoke(c0), middle(e), in_spoke(next(c1))],
+            );
+            push_ring(
+                &[
+                    (quad(c1), 1),
+                    (side(c1), 0),
+                    (side(c0), 1),
+                    (quad(next(c0)), 3),
+                ],
+                &[along(e, 1), out_spoke(c1), middle(e), in_spoke(next(c0))],
+            );
+        }
+    }
+    // Face points.
+    for c in 0..nc {
+        let (f, o, _) = face_range(c);
+        push_ring(
+            &[
+                (quad(c), 2),
+                (side(prev(c)), 2),
+                (central(f), (c - o) as u32),
+                (side(c), 3),
+            ],
+            &[out_spoke(c), in_spoke(c), rim(prev(c)), rim(c)],
+        );
+    }
+
+    Topology::from_parts(
+        vertex_count,
+        face_offsets,
+        face_verts,
+        face_edges,
+        edge_verts,
+        edge_faces,
+        ring_offsets,
+        ring_faces,
+        ring_corners,
+        edge_ring_offsets,
+        ring_edges,
     )
 }
 
@@ -191,6 +371,78 @@ mod tests {
             Point::new(1.5, 1.5),
         );
         assert!((f - Point::new(1.0, 1.0)).hypot() < 1e-12);
+    }
+
+    /// The direct construction gives the connectivity that building from the faces gives.
+    #[test]
+    fn ternary_topology_matches_a_rebuild() {
+        // A quad, a triangle and a pentagon around a boundary, with a hole-free fan.
+        let faces = vec![vec![0, 1, 2, 3], vec![1, 4, 2], vec![2, 4, 5, 6, 3]];
+        let t = Topology::from_faces(7, &faces).unwrap();
+        let child = ternary_topology(&t);
+        let offsets: Vec<u32> = (0..=child.face_count())
+            .map(|f| {
+                if f == child.face_count() {
+                    child.corner_count() as u32
+                } else {
+                    child.face_offset(f) as u32
+                }
+            })
+            .collect();
+        let verts: Vec<u32> = (0..child.face_count())
+            .flat_map(|f| child.face_vertices(f).to_vec())
+            .collect();
+        let rebuilt = Topology::build(child.vertex_count(), offsets, verts, |_, _| false).unwrap();
+        assert_eq!(child.edge_count(), rebuilt.edge_count());
+        assert_eq!(child.euler_characteristic(), t.euler_characteristic());
+        let ends = |t: &Topology, e: u32| {
+            let [a, b] = t.edge_vertices(e as usize);
+            (a.min(b), a.max(b))
+        };
+        for f in 0..child.face_count() {
+            for (e1, e2) in child.face_edges(f).iter().zip(rebuilt.face_edges(f)) {
+                assert_eq!(ends(&child, *e1), ends(&rebuilt, *e2), "face {f}");
+            }
+        }
+        for e in 0..child.edge_count() {
+            let [a, b] = child.edge_vertices(e);
+            let [f0, f1] = child.edge_faces(e);
+            let fv = child.face_vertices(f0 as usize);
+            let k = fv.iter().position(|&x| x == a).unwrap();
+            assert_eq!(
+                fv[(k + 1) % fv.len()],
+                b,
+                "edge {e} runs a->b in its first face"
+            );
+            if f1 != INVALID {
+                let fv = child.face_vertices(f1 as usize);
+                let k = fv.iter().position(|&x| x == b).unwrap();
+                assert_eq!(fv[(k + 1) % fv.len()], a);
+            }
+            let twin = (0..rebuilt.edge_count())
+                .find(|&r| ends(&rebuilt, r as u32) == ends(&child, e as u32))
+                .unwrap();
+            assert_eq!(child.is_boundary_edge(e), rebuilt.is_boundary_edge(twin));
+        }
+        for v in 0..child.vertex_count() {
+            assert_eq!(
+                child.is_boundary_vertex(v),
+                rebuilt.is_boundary_vertex(v),
+                "{v}"
+            );
+            let mut f1 = child.vertex_faces(v).to_vec();
+            let f2 = rebuilt.vertex_faces(v).to_vec();
+            if !child.is_boundary_vertex(v) {
+                let k = f1.iter().position(|&f| f == f2[0]).unwrap();
+                f1.rotate_left(k);
+            }
+            assert_eq!(f1, f2, "ring of {v}");
+            let edges = child.vertex_edges(v);
+            for (k, &f) in child.vertex_faces(v).iter().enumerate() {
+                let fe = child.face_edges(f as usize);
+                assert!(fe.contains(&edges[k]) && fe.contains(&edges[(k + 1) % edges.len()]));
+            }
+        }
     }
 
     #[test]

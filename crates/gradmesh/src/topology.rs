@@ -349,6 +349,44 @@ impl Topology {
         used as i64 - self.edge_count() as i64 + self.face_count() as i64
     }
 
+    /// Assembles a topology from arrays a refinement step built directly (the same layout as
+    /// [`Topology::build`] produces). Debug builds check the rings against the faces.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn from_parts(
+        vertex_count: usize,
+        face_offsets: Vec<u32>,
+        face_verts: Vec<u32>,
+        face_edges: Vec<u32>,
+        edge_verts: Vec<[u32; 2]>,
+        edge_faces: Vec<[u32; 2]>,
+        ring_offsets: Vec<u32>,
+        ring_faces: Vec<u32>,
+        ring_corners: Vec<u32>,
+        edge_ring_offsets: Vec<u32>,
+        ring_edges: Vec<u32>,
+    ) -> Topology {
+        let t = Topology {
+            vertex_count,
+            face_offsets,
+            face_verts,
+            face_edges,
+            edge_verts,
+            edge_faces,
+            ring_offsets,
+            ring_faces,
+            ring_corners,
+            edge_ring_offsets,
+            ring_edges,
+        };
+        #[cfg(debug_assertions)]
+        for v in 0..t.vertex_count {
+            for (&f, &c) in t.vertex_faces(v).iter().zip(t.vertex_face_corners(v)) {
+                debug_assert_eq!(t.face_vertices(f as usize)[c as usize], v as u32);
+            }
+        }
+        t
+    }
+
     /// The topology after one Catmull-Clark split, built directly from this one (no search
     /// for twins): one face point per face, then one edge point per edge, then one vertex
     /// point per vertex. Child face `c` is the quad at flat corner `c`: `[vertex point, edge
