@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use clap::builder::TypedValueParser as _;
 use clap::{Args, Parser, Subcommand};
 
 /// Gradient meshes of arbitrary topology (Lieng, Kosinka, Shen & Dodgson 2017).
@@ -22,6 +23,40 @@ pub enum Command {
     Convert(ConvertArgs),
     /// Write the refined control mesh (or its limit points) at a given level.
     Refine(RefineArgs),
+    /// Render the limit surface of meshes, drawn in order as layers, to a PNG.
+    Render(RenderArgs),
+}
+
+/// Limits on the input (`gradmesh::Limits`), raised for trusted input.
+#[derive(Debug, Args)]
+#[command(next_help_heading = "Limits")]
+pub struct LimitArgs {
+    /// Largest input file, in bytes [default: 268435456].
+    #[arg(long, value_name = "BYTES")]
+    pub max_input_bytes: Option<u64>,
+    /// Most control points in one mesh [default: 16777216].
+    #[arg(long, value_name = "N")]
+    pub max_points: Option<u64>,
+    /// Most faces in one mesh [default: 16777216].
+    #[arg(long, value_name = "N")]
+    pub max_faces: Option<u64>,
+    /// Most face corners in one mesh [default: 67108864].
+    #[arg(long, value_name = "N")]
+    pub max_corners: Option<u64>,
+}
+
+impl LimitArgs {
+    /// The default limits, with the flags given.
+    pub fn limits(&self) -> gradmesh::Limits {
+        let d = gradmesh::Limits::DEFAULT;
+        gradmesh::Limits {
+            input_bytes: self.max_input_bytes.unwrap_or(d.input_bytes),
+            points: self.max_points.unwrap_or(d.points),
+            faces: self.max_faces.unwrap_or(d.faces),
+            corners: self.max_corners.unwrap_or(d.corners),
+            ..d
+        }
+    }
 }
 
 /// `gradmesh info`.
@@ -30,6 +65,9 @@ pub struct InfoArgs {
     /// Input files (.json, .off, .obj).
     #[arg(required = true)]
     pub inputs: Vec<PathBuf>,
+    /// Limits.
+    #[command(flatten)]
+    pub limits: LimitArgs,
 }
 
 /// `gradmesh convert`.
@@ -43,6 +81,9 @@ pub struct ConvertArgs {
     /// Allow the output to be the input file itself.
     #[arg(long)]
     pub force: bool,
+    /// Limits.
+    #[command(flatten)]
+    pub limits: LimitArgs,
 }
 
 /// `gradmesh refine`.
@@ -62,4 +103,67 @@ pub struct RefineArgs {
     /// Allow the output to be the input file itself.
     #[arg(long)]
     pub force: bool,
+    /// Deepest refinement level accepted [default: 12].
+    #[arg(long, value_name = "LEVEL", help_heading = "Limits")]
+    pub max_level: Option<usize>,
+    /// Most faces of the deepest level, estimated before refining [default: 8388608].
+    #[arg(long, value_name = "N", help_heading = "Limits")]
+    pub max_refined_faces: Option<u64>,
+    /// Limits.
+    #[command(flatten)]
+    pub limits: LimitArgs,
+}
+
+/// `gradmesh render`.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    /// Input files (.json, .off, .obj), drawn in order: the first at the bottom.
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    /// Output file (.png).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Image width in pixels (with only --height, derived from the view's aspect ratio).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height in pixels (with only --width, derived from the view's aspect ratio).
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// The rectangle of the plane shown: X0 Y0 is the top-left corner, y grows downward.
+    /// Default: the bounds of the meshes.
+    #[arg(long, num_args = 4, value_names = ["X0", "Y0", "X1", "Y1"], allow_negative_numbers = true)]
+    pub view: Option<Vec<f64>>,
+    /// Background colour (a CSS colour such as white or #202020); default transparent.
+    #[arg(long)]
+    pub background: Option<String>,
+    /// Bits per channel of the PNG: 8 or 16.
+    #[arg(long, default_value_t = 8, value_parser = clap::builder::PossibleValuesParser::new(["8", "16"]).map(|s| s.parse::<u8>().unwrap()))]
+    pub bits: u8,
+    /// Do not dither 8-bit output.
+    #[arg(long)]
+    pub no_dither: bool,
+    /// Draw the outline of each mesh on top, one pixel wide.
+    #[arg(long)]
+    pub boundary: bool,
+    /// Interpolate in this colour space instead of each mesh's own: lab, oklab, srgb-linear, srgb.
+    #[arg(long)]
+    pub colour_space: Option<String>,
+    /// Gamut mapping of out-of-gamut colours: chroma (reduce chroma in Oklch) or clip.
+    #[arg(long)]
+    pub gamut: Option<String>,
+    /// Slow and simple reference rendering (for checking the fast path).
+    #[arg(long)]
+    pub reference: bool,
+    /// Refine to this level instead of choosing one from the image size.
+    #[arg(long)]
+    pub level: Option<usize>,
+    /// Print the time each stage took, and the level drawn for each layer.
+    #[arg(long)]
+    pub timings: bool,
+    /// Allow the output to be one of the input files.
+    #[arg(long)]
+    pub force: bool,
+    /// Limits.
+    #[command(flatten)]
+    pub limits: LimitArgs,
 }

@@ -205,3 +205,77 @@ fn errors_name_the_file_and_the_element() {
     assert!(!o.status.success());
     assert!(stderr(&o).contains(".obj or .json"), "{}", stderr(&o));
 }
+
+#[test]
+fn refinement_beyond_the_limits_is_refused_before_building() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("t.off");
+    std::fs::write(
+        &input,
+        "OFF\n3 1 0\n0 0 0 50 0 0 0\n1 0 0 60 0 0 0\n0 1 0 70 0 0 0\n3 0 1 2\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out.obj");
+    let start = std::time::Instant::now();
+    let o = gradmesh(&["refine", s(&input), "-o", s(&out), "-l", "12"]);
+    assert!(!o.status.success());
+    assert!(start.elapsed() < std::time::Duration::from_secs(5));
+    assert!(
+        stderr(&o).contains(
+            "t.off: layer 0: the number of faces of refinement level 12 (about 22 GB of memory) is 28,311,552, above the limit of 8,388,608"
+        ),
+        "{}",
+        stderr(&o)
+    );
+    let o = gradmesh(&["refine", s(&input), "-o", s(&out), "-l", "13"]);
+    assert!(stderr(&o).contains("the refinement level is 13, above the limit of 12"));
+    // The limits are raised or lowered by flags.
+    let o = gradmesh(&[
+        "refine",
+        s(&input),
+        "-o",
+        s(&out),
+        "-l",
+        "2",
+        "--max-refined-faces",
+        "10",
+    ]);
+    assert!(
+        stderr(&o).contains("above the limit of 10"),
+        "{}",
+        stderr(&o)
+    );
+    let o = gradmesh(&["refine", s(&input), "-o", s(&out), "-l", "2"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = gradmesh(&["info", s(&input), "--max-points", "2"]);
+    assert!(
+        stderr(&o).contains("t.off:2: the number of vertices is 3, above the limit of 2"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!dir.path().join("out.json").exists());
+}
+
+#[test]
+fn output_into_a_missing_directory_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("t.off");
+    std::fs::write(
+        &input,
+        "OFF\n3 1 0\n0 0 0 50 0 0 0\n1 0 0 60 0 0 0\n0 1 0 70 0 0 0\n3 0 1 2\n",
+    )
+    .unwrap();
+    let out = dir.path().join("missing/out.json");
+    let o = gradmesh(&["convert", s(&input), "-o", s(&out)]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("missing does not exist"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!dir.path().join("missing").exists());
+    let o = gradmesh(&["convert", s(&input), "-o", s(dir.path())]);
+    assert!(!o.status.success());
+    let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(names.len(), 1, "a temporary file was left behind");
+}

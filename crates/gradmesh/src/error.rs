@@ -156,7 +156,11 @@ pub enum ErrorKind {
         message: String,
     },
     /// A limit protecting against runaway input was exceeded.
-    #[error("{what} is {found}, above the limit of {limit}")]
+    #[error(
+        "{what} is {}, above the limit of {}",
+        crate::limits::group_digits(*.found),
+        crate::limits::group_digits(*.limit)
+    )]
     LimitExceeded {
         /// What was counted.
         what: String,

@@ -5,7 +5,8 @@
 //!
 //! 1. [`GradientMesh`]: control points with colours, handles and edge tags, checked by
 //!    [`validate`](fn@validate);
-//! 2. [`ternary_step`](mod@ternary_step): the special first refinement that makes colours interpolating;
+//! 2. [`ternary_step`](mod@ternary_step): the special first refinement that makes colours interpolating
+//!    (or [`binary_step`](mod@binary_step), the paper's alternative of two binary splits);
 //! 3. [`catmull_clark`](mod@catmull_clark): Catmull-Clark refinement with Pixar's rules, topology refined once and
 //!    data interpolated with precomputed stencils;
 //! 4. [`limit`](mod@limit): limit positions and colours of refined vertices.
@@ -30,11 +31,13 @@
 //! # Ok::<(), gradmesh::Error>(())
 //! ```
 
+pub mod binary_step;
 pub mod catmull_clark;
 pub mod colour;
 pub mod error;
 pub mod formats;
 pub mod limit;
+pub mod limits;
 pub mod mesh;
 pub mod refine;
 pub mod render;
@@ -45,9 +48,10 @@ pub mod validate;
 
 pub use colour::ColourSpace;
 pub use error::{Error, ErrorKind, Location, Result, Warning};
+pub use limits::Limits;
 pub use mesh::{
-    BoundaryInterpolation, ControlPoint, CreasingMethod, Document, EdgeKind, EdgeTag, GradientMesh,
-    WedgeOverride,
+    BoundaryInterpolation, ControlPoint, CreasingMethod, Document, EdgeKind, EdgeTag, FirstStep,
+    GradientMesh, WedgeOverride,
 };
 pub use refine::{RefinedMesh, Refinement};
 pub use topology::Topology;

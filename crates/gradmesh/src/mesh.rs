@@ -130,6 +130,28 @@ impl CreasingMethod {
     }
 }
 
+/// The special first refinement that makes colours interpolating (paper sections 4.3 and 4.5).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FirstStep {
+    /// One linear ternary split (the paper's choice, the default): a face of `n` corners
+    /// becomes a central `n`-gon surrounded by `2 n` quads.
+    #[default]
+    Ternary,
+    /// Two linear binary splits (the paper's alternative): a face of `n` corners becomes `4 n`
+    /// quads, with more points to place (see `docs/binary-step.md`).
+    Binary,
+}
+
+impl FirstStep {
+    /// The name used in files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            FirstStep::Ternary => "ternary",
+            FirstStep::Binary => "binary",
+        }
+    }
+}
+
 /// The colour, opacity and handles of one side of a discontinuous edge at one of its points.
 ///
 /// The faces around a point on a discontinuous edge fall into wedges separated by the
@@ -164,9 +186,12 @@ pub struct GradientMesh {
     pub boundary: BoundaryInterpolation,
     /// Sharpness subdivision rule for semi-sharp creases.
     pub creasing: CreasingMethod,
-    /// Move each control point's vertex after the ternary step so that the limit surface
-    /// passes through the control point (paper section 4.5). Off by default, as in the paper.
+    /// Move each control point's vertex after the first step (ternary or binary) so that the
+    /// limit surface passes through the control point (paper section 4.5). Off by default, as
+    /// in the paper.
     pub interpolate_positions: bool,
+    /// The special first refinement: one ternary split (default) or two binary splits.
+    pub first_step: FirstStep,
     /// The control points.
     pub points: Vec<ControlPoint>,
     /// Faces as loops of point indices, all wound the same way.
@@ -188,6 +213,7 @@ impl Default for GradientMesh {
             boundary: BoundaryInterpolation::EdgeAndCorner,
             creasing: CreasingMethod::Uniform,
             interpolate_positions: false,
+            first_step: FirstStep::Ternary,
             points: Vec::new(),
             faces: Vec::new(),
             handles: BTreeMap::new(),

@@ -1,14 +1,17 @@
 //! The whole refinement: topology of every level built once, data evaluated on demand.
 //!
 //! Level 0 is the validated input (discontinuities split), level 1 the result of the ternary
-//! step, level `k` the ternary step followed by `k - 1` Catmull-Clark steps. Only the ternary
-//! step's positions depend non-linearly on the data (through the handles); every later level is
-//! a fixed linear map, so re-evaluating after an edit costs one pass over the stencils.
+//! step (or of the two binary splits, [`FirstStep::Binary`]), level `k` that step followed by
+//! `k - 1` Catmull-Clark steps. Only the first step's positions depend non-linearly on the
+//! data (through the handles); every later level is a fixed linear map, so re-evaluating
+//! after an edit costs one pass over the stencils.
 
+use crate::binary_step;
 use crate::catmull_clark::{self, Level, Stencils};
 use crate::error::{Error, Warning};
 use crate::limit;
-use crate::mesh::GradientMesh;
+use crate::limits::Limits;
+use crate::mesh::{FirstStep, GradientMesh};
 use crate::rules;
 use crate::ternary_step;
 use crate::topology::Topology;
@@ -41,6 +44,20 @@ impl Refinement {
         Ok((Refinement::from_base(base, depth), warnings))
     }
 
+    /// As [`Refinement::new`], but first refuses a mesh beyond `limits` (points, faces,
+    /// corners) and a refinement whose deepest level would exceed them (level, faces, 32-bit
+    /// indices), estimated before anything is built ([`Limits::check_refinement`]).
+    pub fn new_with_limits(
+        mesh: &GradientMesh,
+        depth: usize,
+        limits: &Limits,
+    ) -> Result<(Refinement, Vec<Warning>), Error> {
+        limits.check_mesh(mesh)?;
+        let (base, warnings) = BaseMesh::new(mesh)?;
+        limits.check_refinement(&base, depth)?;
+        Ok((Refinement::from_base(base, depth), warnings))
+    }
+
     /// Refines the topology of an already validated base level down to level `depth`.
     pub fn from_base(base: BaseMesh, depth: usize) -> Refinement {
         let mut r = Refinement {
@@ -68,7 +85,7 @@ impl Refinement {
     /// Refines further so that level `depth` exists.
     pub fn extend_to(&mut self, depth: usize) {
         if depth >= 1 && self.levels.is_empty() {
-            self.levels.push(ternary_step::ternary_level(&self.base));
+            self.levels.push(first_level(&self.base));
         }
         while self.levels.len() < depth {
             let (child, stencils) = catmull_clark::refine(self.levels.last().expect("level 1"));
@@ -127,7 +144,7 @@ impl Refinement {
     pub fn evaluate_with(&self, base: &BaseMesh) -> RefinedMesh {
         let mut levels = vec![base.data.clone()];
         if !self.levels.is_empty() {
-            let mut level1 = ternary_step::ternary_data(base);
+            let mut level1 = first_data(base);
             if let Some((d, limit)) = &self.interpolation {
                 self.interpolate_positions(base, *d, limit, &mut level1);
             }
@@ -215,7 +232,7 @@ impl Refinement {
         let mut d = data.levels.last().expect("level 0").clone();
         let mut at = data.levels.len() - 1;
         if at == 0 {
-            d = ternary_step::ternary_data(&self.base);
+            d = first_data(&self.base);
             at = 1;
         }
         while at < j {
@@ -223,6 +240,22 @@ impl Refinement {
             at += 1;
         }
         d
+    }
+}
+
+/// Level 1 (topology and sharpness) by the first step that `base` asks for.
+fn first_level(base: &BaseMesh) -> Level {
+    match base.first_step {
+        FirstStep::Ternary => ternary_step::ternary_level(base),
+        FirstStep::Binary => binary_step::binary_level(base),
+    }
+}
+
+/// The level-1 data by the first step that `base` asks for.
+fn first_data(base: &BaseMesh) -> Vec<VertexData> {
+    match base.first_step {
+        FirstStep::Ternary => ternary_step::ternary_data(base),
+        FirstStep::Binary => binary_step::binary_data(base),
     }
 }
 

@@ -9,8 +9,27 @@ use std::collections::{BTreeMap, HashMap};
 use kurbo::Vec2;
 
 use crate::error::{Error, ErrorKind, Warning};
-use crate::mesh::{edge_key, BoundaryInterpolation, CreasingMethod, EdgeKind, GradientMesh};
+use crate::mesh::{
+    edge_key, BoundaryInterpolation, CreasingMethod, EdgeKind, FirstStep, GradientMesh,
+};
 use crate::topology::{flatten, Topology};
+
+/// The largest magnitude of a coordinate, handle component or colour channel: the refinement
+/// squares differences of positions, which overflow beyond about 1e154.
+pub const MAX_MAGNITUDE: f64 = 1e150;
+
+/// The largest magnitude of a coordinate of a mesh with
+/// [`GradientMesh::interpolate_positions`]: the correction measures each point's weight by
+/// moving it one unit, which is lost in rounding at larger coordinates.
+pub const MAX_INTERPOLATED_MAGNITUDE: f64 = 1e12;
+
+/// The shortest edge refined: squared lengths of shorter edges underflow to zero.
+pub const MIN_EDGE_LENGTH: f64 = 1e-150;
+
+/// The most times a handle may be longer than its edge: the ternary step multiplies the two
+/// ratios of a corner's handles, which must stay far from overflow. (Handles longer than half
+/// their edge are already warned about.)
+pub const MAX_HANDLE_RATIO: f64 = 1e50;
 
 /// Per-vertex data carried through refinement: `[x, y, c0, c1, c2, opacity]`.
 pub type VertexData = [f64; 6];
@@ -37,6 +56,8 @@ pub struct BaseMesh {
     pub creasing: CreasingMethod,
     /// Whether limit positions interpolate the control points.
     pub interpolate_positions: bool,
+    /// The special first refinement (level 1).
+    pub first_step: FirstStep,
 }
 
 fn not_finite(what: String, value: f64) -> Error {
@@ -95,6 +116,13 @@ impl BaseMesh {
                 }
                 .into());
             }
+            let len = (q.x - p.x).hypot(q.y - p.y);
+            if len < MIN_EDGE_LENGTH {
+                return Err(invalid(
+                    format!("edge {}-{}", a.min(b), a.max(b)),
+                    format!("its length {len:e} is below {MIN_EDGE_LENGTH:e}: too short to refine"),
+                ));
+            }
         }
         for &(a, b) in mesh.edges.keys() {
             if !edge_index.contains_key(&(a, b)) {
@@ -115,8 +143,8 @@ impl BaseMesh {
                 }
                 .into());
             }
-            let len =
-                (mesh.points[to as usize].position - mesh.points[from as usize].position).hypot();
+            let len = edge_length(mesh, from, to);
+            check_handle_ratio(&format!("handle of point {from} towards {to}"), *h, len)?;
             if h.hypot() > 0.5 * len * (1.0 + 1e-9) {
                 warn(
                     &mut warnings,
@@ -231,7 +259,7 @@ impl BaseMesh {
             if let Some(o) = w.opacity {
                 d[5] = o;
             }
-            for &to in w.handles.keys() {
+            for (&to, &h) in &w.handles {
                 if !edge_index.contains_key(&edge_key(w.point, to)) {
                     return Err(ErrorKind::NoSuchEdge {
                         what: format!("handle of {what}"),
@@ -240,6 +268,11 @@ impl BaseMesh {
                     }
                     .into());
                 }
+                check_handle_ratio(
+                    &format!("handle of {what} towards {to}"),
+                    h,
+                    edge_length(mesh, w.point, to),
+                )?;
             }
             override_handles[id] = Some(&w.handles);
             if wedge_faces[id].len() == whole.vertex_faces(w.point as usize).len() {
@@ -312,10 +345,43 @@ impl BaseMesh {
                 boundary: mesh.boundary,
                 creasing: mesh.creasing,
                 interpolate_positions: mesh.interpolate_positions,
+                first_step: mesh.first_step,
             },
             warnings,
         ))
     }
+}
+
+/// The length of the edge between points `a` and `b`, without overflow or underflow.
+fn edge_length(mesh: &GradientMesh, a: u32, b: u32) -> f64 {
+    let d = mesh.points[b as usize].position - mesh.points[a as usize].position;
+    d.x.hypot(d.y)
+}
+
+/// Refuses a handle more than [`MAX_HANDLE_RATIO`] times as long as its edge.
+fn check_handle_ratio(what: &str, h: Vec2, edge_length: f64) -> Result<(), Error> {
+    let len = h.x.hypot(h.y);
+    if len > MAX_HANDLE_RATIO * edge_length {
+        return Err(invalid(
+            what.to_string(),
+            format!(
+                "its length {len:e} is more than {MAX_HANDLE_RATIO:e} times its edge's \
+                 ({edge_length:e})"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses a finite value beyond [`MAX_MAGNITUDE`].
+fn check_magnitude(what: impl FnOnce() -> String, v: f64) -> Result<(), Error> {
+    if v.abs() > MAX_MAGNITUDE {
+        return Err(invalid(
+            what(),
+            format!("{v:e} is beyond ±{MAX_MAGNITUDE:e}, the largest magnitude refined without overflow"),
+        ));
+    }
+    Ok(())
 }
 
 fn check_numbers(mesh: &GradientMesh) -> Result<(), Error> {
@@ -324,11 +390,22 @@ fn check_numbers(mesh: &GradientMesh) -> Result<(), Error> {
             if !v.is_finite() {
                 return Err(not_finite(format!("point {i} {name}"), v));
             }
+            check_magnitude(|| format!("point {i} {name}"), v)?;
+            if mesh.interpolate_positions && v.abs() > MAX_INTERPOLATED_MAGNITUDE {
+                return Err(invalid(
+                    format!("point {i} {name}"),
+                    format!(
+                        "{v:e} is beyond ±{MAX_INTERPOLATED_MAGNITUDE:e}, the largest magnitude \
+                         with interpolate_positions"
+                    ),
+                ));
+            }
         }
         for (k, &c) in p.colour.iter().enumerate() {
             if !c.is_finite() {
                 return Err(not_finite(format!("point {i} colour channel {k}"), c));
             }
+            check_magnitude(|| format!("point {i} colour channel {k}"), c)?;
         }
         if !p.opacity.is_finite() {
             return Err(not_finite(format!("point {i} opacity"), p.opacity));
@@ -345,6 +422,7 @@ fn check_numbers(mesh: &GradientMesh) -> Result<(), Error> {
             if !v.is_finite() {
                 return Err(not_finite(format!("handle {from}->{to} {name}"), v));
             }
+            check_magnitude(|| format!("handle {from}->{to} {name}"), v)?;
         }
         if from as usize >= mesh.points.len() || to as usize >= mesh.points.len() {
             return Err(ErrorKind::NoSuchEdge {
@@ -370,6 +448,7 @@ fn check_numbers(mesh: &GradientMesh) -> Result<(), Error> {
             if !c.is_finite() {
                 return Err(not_finite(format!("wedge {i} colour channel {k}"), c));
             }
+            check_magnitude(|| format!("wedge {i} colour channel {k}"), c)?;
         }
         if let Some(o) = w.opacity {
             if !(0.0..=1.0).contains(&o) {
@@ -386,6 +465,8 @@ fn check_numbers(mesh: &GradientMesh) -> Result<(), Error> {
                     h.x + h.y,
                 ));
             }
+            check_magnitude(|| format!("wedge {i} handle towards {to}"), h.x)?;
+            check_magnitude(|| format!("wedge {i} handle towards {to}"), h.y)?;
         }
     }
     Ok(())

@@ -180,6 +180,13 @@ fn examples_load_validate_and_round_trip() {
             validate(mesh).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         }
         assert_round_trip(&doc, &path.display().to_string());
+        // The examples are written canonically: reading and writing changes no byte.
+        let text = fs::read_to_string(&path).unwrap();
+        assert!(
+            json::write_document(&doc) == text,
+            "{}: writing the document back changes it",
+            path.display()
+        );
     }
 }
 
@@ -290,7 +297,7 @@ fn off_errors_name_the_line() {
         ),
         (
             good.replacen("4 3 1", "100000000 3 1", 1),
-            "t.off:2: the number of vertices is 100000000, above the limit of 16777216",
+            "t.off:2: the number of vertices is 100,000,000, above the limit of 16,777,216",
         ),
     ];
     for (text, expected) in cases {

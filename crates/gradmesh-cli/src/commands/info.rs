@@ -11,8 +11,9 @@ use crate::args::InfoArgs;
 
 pub fn run(args: &InfoArgs) -> Result<(), Error> {
     let mut failed = None;
+    let limits = args.limits.limits();
     for path in &args.inputs {
-        match super::read(path) {
+        match super::read(path, &limits) {
             Ok(doc) => {
                 println!("{}", path.display());
                 for (i, mesh) in doc.layers.iter().enumerate() {

@@ -3,6 +3,7 @@
 mod convert;
 mod info;
 mod refine;
+mod render;
 
 use std::path::Path;
 
@@ -16,12 +17,13 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::Info(a) => info::run(&a),
         Command::Convert(a) => convert::run(&a),
         Command::Refine(a) => refine::run(&a),
+        Command::Render(a) => render::run(&a),
     }
 }
 
-/// Reads a document, with errors located in the file.
-fn read(path: &Path) -> Result<Document, Error> {
-    gradmesh::formats::read_path(path)
+/// Reads a document within `limits`, with errors located in the file.
+fn read(path: &Path, limits: &gradmesh::Limits) -> Result<Document, Error> {
+    gradmesh::formats::read_path_with(path, limits)
 }
 
 /// Refuses to write over an input unless `force` is given.

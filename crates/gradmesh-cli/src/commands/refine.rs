@@ -16,11 +16,25 @@ pub fn run(args: &RefineArgs) -> Result<(), Error> {
             )))
         })?;
     super::check_not_input(&args.output, &[&args.input], args.force)?;
-    let doc = super::read(&args.input)?;
+    let mut limits = args.limits.limits();
+    if let Some(level) = args.max_level {
+        limits.refinement_level = level;
+    }
+    if let Some(faces) = args.max_refined_faces {
+        limits.refined_faces = faces;
+    }
+    let doc = super::read(&args.input, &limits)?;
     let mut layers = Vec::with_capacity(doc.layers.len());
     for (i, mesh) in doc.layers.iter().enumerate() {
         let locate = |e: Error| e.in_layer(i).in_file(&args.input);
-        let (mut refinement, warnings) = Refinement::new(mesh, args.levels).map_err(locate)?;
+        let (mut refinement, warnings) =
+            Refinement::new_with_limits(mesh, args.levels, &limits).map_err(locate)?;
+        if args.limit {
+            // Limit points of levels 0 and 1 are computed from level 2.
+            limits
+                .check_refinement(refinement.base(), args.levels.max(2))
+                .map_err(locate)?;
+        }
         super::print_warnings(&args.input, &warnings);
         let data = refinement.evaluate();
         let points = if args.limit {

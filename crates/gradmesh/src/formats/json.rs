@@ -14,14 +14,15 @@ use serde::de::{self, Deserialize, Deserializer, IgnoredAny, MapAccess, SeqAcces
 
 use crate::colour::{parse_css_colour, ColourSpace};
 use crate::error::{Error, ErrorKind, Location};
+use crate::limits::Limits;
 use crate::mesh::{
     edge_key, BoundaryInterpolation, ControlPoint, CreasingMethod, Document, EdgeKind, EdgeTag,
-    GradientMesh, WedgeOverride,
+    FirstStep, GradientMesh, WedgeOverride,
 };
 use crate::topology::Topology;
 use crate::validate::VertexData;
 
-use super::{check_count, check_size, MAX_FACES, MAX_POINTS};
+use super::{check_count, check_size};
 
 /// The value of `"format"` in a gradient-mesh document.
 pub const FORMAT_NAME: &str = "gradmesh";
@@ -32,8 +33,9 @@ pub const REFINED_FORMAT_NAME: &str = "gradmesh-refined";
 /// The version of the format this module reads and writes.
 pub const VERSION: u64 = 1;
 
-/// The deepest nesting of arrays and objects accepted (a document needs 7).
-pub const MAX_NESTING_DEPTH: usize = 64;
+/// The deepest nesting of arrays and objects accepted by default (a document needs 7):
+/// [`Limits::nesting_depth`].
+pub const MAX_NESTING_DEPTH: usize = Limits::DEFAULT.nesting_depth;
 
 // ---------------------------------------------------------------------------------------------
 // Reading
@@ -45,10 +47,19 @@ pub const MAX_NESTING_DEPTH: usize = 64;
 /// cannot represent or would silently merge: indices in range, no point joined to itself, no
 /// repeated handle, edge or face corner, opacities in 0..=1, crease sharpness >= 0. The topology
 /// (manifoldness, winding, handles along existing edges) is checked by [`crate::validate()`].
+///
+/// Input beyond the default [`Limits`] is refused.
 pub fn read_document(text: &str) -> Result<Document, Error> {
-    check_size(text.len() as u64)?;
+    read_document_with(text, &Limits::DEFAULT)
+}
+
+/// Reads a document in the native format as [`read_document`] does, within `limits`: input
+/// bytes and nesting depth (checked before parsing), and points, faces and corners of each
+/// layer (checked before the layer is converted).
+pub fn read_document_with(text: &str, limits: &Limits) -> Result<Document, Error> {
+    check_size(text.len() as u64, limits.input_bytes)?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    check_nesting(text)?;
+    check_nesting(text, limits.nesting_depth)?;
     let header: Header = serde_json::from_str(text).map_err(|e| serde_error(text, e))?;
     check_header(text, &header)?;
     let raw: RawDocument = serde_json::from_str(text).map_err(|e| serde_error(text, e))?;
@@ -56,13 +67,13 @@ pub fn read_document(text: &str) -> Result<Document, Error> {
         .layers
         .into_iter()
         .enumerate()
-        .map(|(l, layer)| convert_layer(text, l, layer))
+        .map(|(l, layer)| convert_layer(text, l, layer, limits))
         .collect::<Result<_, _>>()?;
     Ok(Document { layers })
 }
 
-/// Refuses nesting deeper than [`MAX_NESTING_DEPTH`] before serde recurses into it.
-fn check_nesting(text: &str) -> Result<(), Error> {
+/// Refuses nesting deeper than `max_depth` before serde recurses into it.
+fn check_nesting(text: &str, max_depth: usize) -> Result<(), Error> {
     let (mut depth, mut line) = (0usize, 1usize);
     let (mut in_string, mut escaped) = (false, false);
     for &b in text.as_bytes() {
@@ -82,13 +93,13 @@ fn check_nesting(text: &str) -> Result<(), Error> {
             b'"' => in_string = true,
             b'[' | b'{' => {
                 depth += 1;
-                if depth > MAX_NESTING_DEPTH {
+                if depth > max_depth {
                     return Err(Error {
                         location: Location::default().at_line(line),
                         kind: ErrorKind::LimitExceeded {
                             what: "the nesting depth of arrays and objects".into(),
                             found: depth as u64,
-                            limit: MAX_NESTING_DEPTH as u64,
+                            limit: max_depth as u64,
                         },
                     });
                 }
@@ -209,6 +220,8 @@ struct RawLayer {
     creasing: Option<String>,
     #[serde(default)]
     interpolate_positions: bool,
+    #[serde(default)]
+    first_step: Option<String>,
     points: Vec<RawPoint>,
     faces: Vec<Vec<Index>>,
     #[serde(default)]
@@ -439,6 +452,12 @@ fn resolve_colour(
     match raw {
         RawColour::Numbers(c) => Ok((c, None, 1.0)),
         RawColour::Text(t) => match css_colour(&t, space) {
+            Ok((c, _)) if c.iter().any(|x| !x.is_finite()) => Err(format!(
+                "expected 3 numbers or a CSS colour string, found {}, which gives a colour that \
+                 is not finite ({c:?} in {})",
+                quoted(&t),
+                space.name()
+            )),
             Ok((c, alpha)) => Ok((c, Some(t), alpha)),
             Err(e) => Err(format!(
                 "expected 3 numbers or a CSS colour string, found {} ({e})",
@@ -713,7 +732,12 @@ impl LayerReader<'_> {
     }
 }
 
-fn convert_layer(text: &str, layer: usize, raw: RawLayer) -> Result<GradientMesh, Error> {
+fn convert_layer(
+    text: &str,
+    layer: usize,
+    raw: RawLayer,
+    limits: &Limits,
+) -> Result<GradientMesh, Error> {
     let reader = LayerReader {
         text,
         layer,
@@ -726,6 +750,7 @@ fn convert_layer(text: &str, layer: usize, raw: RawLayer) -> Result<GradientMesh
     ]
     .map(|b| (b.name(), b));
     let creasings = [CreasingMethod::Uniform, CreasingMethod::Chaikin].map(|c| (c.name(), c));
+    let first_steps = [FirstStep::Ternary, FirstStep::Binary].map(|s| (s.name(), s));
 
     let limit = |e: Error, field: &str| {
         let path = item("layers", layer, &[field]);
@@ -738,10 +763,16 @@ fn convert_layer(text: &str, layer: usize, raw: RawLayer) -> Result<GradientMesh
             ..e
         }
     };
-    check_count("the number of points", raw.points.len() as u64, MAX_POINTS)
-        .map_err(|e| limit(e, "points"))?;
-    check_count("the number of faces", raw.faces.len() as u64, MAX_FACES)
+    check_count(
+        "the number of points",
+        raw.points.len() as u64,
+        limits.points,
+    )
+    .map_err(|e| limit(e, "points"))?;
+    check_count("the number of faces", raw.faces.len() as u64, limits.faces)
         .map_err(|e| limit(e, "faces"))?;
+    let corners = raw.faces.iter().map(|f| f.len() as u64).sum();
+    check_count("the number of corners", corners, limits.corners).map_err(|e| limit(e, "faces"))?;
 
     let mut mesh = GradientMesh {
         name: raw.name,
@@ -749,6 +780,7 @@ fn convert_layer(text: &str, layer: usize, raw: RawLayer) -> Result<GradientMesh
         boundary: reader.named("boundary", raw.boundary.as_deref(), &boundaries)?,
         creasing: reader.named("creasing", raw.creasing.as_deref(), &creasings)?,
         interpolate_positions: raw.interpolate_positions,
+        first_step: reader.named("first_step", raw.first_step.as_deref(), &first_steps)?,
         points: Vec::with_capacity(raw.points.len()),
         faces: Vec::with_capacity(raw.faces.len()),
         ..GradientMesh::default()
@@ -1091,6 +1123,7 @@ fn reword(raw: &str) -> String {
     match raw {
         "number out of range" => "number out of range (not a finite 64-bit number)".into(),
         "trailing characters" => "unexpected text after the end of the document".into(),
+        "expected value" => "expected a JSON value (NaN and Infinity are not JSON numbers)".into(),
         _ => expected(raw),
     }
 }
@@ -1205,6 +1238,9 @@ fn write_layer(mesh: &GradientMesh, indent: usize) -> String {
     }
     if mesh.interpolate_positions {
         fields.push(("interpolate_positions", "true".to_string()));
+    }
+    if mesh.first_step != FirstStep::Ternary {
+        fields.push(("first_step", string(mesh.first_step.name())));
     }
     let points = mesh.points.iter().enumerate().map(|(p, cp)| {
         let p = p as u32;

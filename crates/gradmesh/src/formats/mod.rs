@@ -1,7 +1,8 @@
 //! Reading and writing gradient meshes: the native JSON format, the authors' OFF, and OBJ.
 //!
 //! The native format is specified in `docs/format.md`. Every reader reports errors with the line
-//! they occur on, and refuses input beyond the limits below before allocating for it.
+//! they occur on, and refuses input beyond its [`Limits`] (the `_with` functions; the others use
+//! [`Limits::DEFAULT`]) before allocating for it.
 
 pub mod json;
 pub mod obj;
@@ -13,16 +14,17 @@ use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::error::{Error, ErrorKind, Location};
+use crate::limits::Limits;
 use crate::mesh::{Document, GradientMesh};
 
-/// The largest input accepted, in bytes (256 MiB).
-pub const MAX_INPUT_BYTES: u64 = 256 * 1024 * 1024;
+/// The largest input accepted by default, in bytes (256 MiB): [`Limits::input_bytes`].
+pub const MAX_INPUT_BYTES: u64 = Limits::DEFAULT.input_bytes;
 
-/// The most control points one mesh may have.
-pub const MAX_POINTS: u64 = 1 << 24;
+/// The most control points one mesh may have by default: [`Limits::points`].
+pub const MAX_POINTS: u64 = Limits::DEFAULT.points;
 
-/// The most faces one mesh may have.
-pub const MAX_FACES: u64 = 1 << 24;
+/// The most faces one mesh may have by default: [`Limits::faces`].
+pub const MAX_FACES: u64 = Limits::DEFAULT.faces;
 
 /// A file format, known by its extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -61,22 +63,36 @@ impl Format {
     }
 }
 
-/// Reads a document from text in the given format. OFF and OBJ files give one unnamed layer.
+/// Reads a document from text in the given format, within the default [`Limits`]. OFF and OBJ
+/// files give one unnamed layer.
 pub fn read_str(text: &str, format: Format) -> Result<Document, Error> {
+    read_str_with(text, format, &Limits::DEFAULT)
+}
+
+/// Reads a document from text in the given format, refusing input beyond `limits` (input bytes,
+/// points, faces and corners per mesh, JSON nesting). OFF and OBJ files give one unnamed layer.
+pub fn read_str_with(text: &str, format: Format, limits: &Limits) -> Result<Document, Error> {
     match format {
-        Format::Json => json::read_document(text),
-        Format::Off => off::read_off(text).map(single_layer),
-        Format::Obj => obj::read_obj(text).map(single_layer),
+        Format::Json => json::read_document_with(text, limits),
+        Format::Off => off::read_off_with(text, limits).map(single_layer),
+        Format::Obj => obj::read_obj_with(text, limits).map(single_layer),
     }
 }
 
-/// Reads a document from a file, choosing the format by the extension. OFF and OBJ files give one
-/// layer named after the file stem. Every error is located in the file.
+/// Reads a document from a file within the default [`Limits`], choosing the format by the
+/// extension. OFF and OBJ files give one layer named after the file stem. Every error is located
+/// in the file.
 pub fn read_path(path: &Path) -> Result<Document, Error> {
-    read_path_unlocated(path).map_err(|e| e.in_file(path))
+    read_path_with(path, &Limits::DEFAULT)
 }
 
-fn read_path_unlocated(path: &Path) -> Result<Document, Error> {
+/// Reads a document from a file as [`read_path`] does, refusing input beyond `limits`. A file
+/// larger than [`Limits::input_bytes`] is refused before it is read.
+pub fn read_path_with(path: &Path, limits: &Limits) -> Result<Document, Error> {
+    read_path_unlocated(path, limits).map_err(|e| e.in_file(path))
+}
+
+fn read_path_unlocated(path: &Path, limits: &Limits) -> Result<Document, Error> {
     let format = Format::from_path(path).ok_or_else(|| {
         let found = match path.extension() {
             Some(ext) => format!("the extension \".{}\"", ext.to_string_lossy()),
@@ -86,8 +102,8 @@ fn read_path_unlocated(path: &Path) -> Result<Document, Error> {
             "cannot tell the format from {found}: expected .json, .off or .obj"
         )))
     })?;
-    let text = read_text(path)?;
-    let mut doc = read_str(&text, format)?;
+    let text = read_text(path, limits.input_bytes)?;
+    let mut doc = read_str_with(&text, format, limits)?;
     if format != Format::Json {
         if let Some(stem) = path.file_stem() {
             for layer in &mut doc.layers {
@@ -98,18 +114,26 @@ fn read_path_unlocated(path: &Path) -> Result<Document, Error> {
     Ok(doc)
 }
 
-/// Reads a whole UTF-8 file, refusing one larger than [`MAX_INPUT_BYTES`].
-fn read_text(path: &Path) -> Result<String, Error> {
+/// Reads a whole UTF-8 file, refusing one larger than `max_bytes`.
+fn read_text(path: &Path, max_bytes: u64) -> Result<String, Error> {
     let io = |e: std::io::Error| Error::new(ErrorKind::Io(format!("cannot read the file: {e}")));
     let file = fs::File::open(path).map_err(io)?;
-    let declared = file.metadata().map_err(io)?.len();
-    check_size(declared)?;
-    let mut bytes = Vec::with_capacity(declared as usize);
+    let metadata = file.metadata().map_err(io)?;
+    if metadata.is_dir() {
+        return Err(Error::new(ErrorKind::Io(
+            "cannot read the file: it is a directory".into(),
+        )));
+    }
+    let declared = metadata.len();
+    check_size(declared, max_bytes)?;
+    // Files that are not regular (pipes, devices) report no useful size: read them up to the
+    // limit.
+    let mut bytes = Vec::with_capacity((declared as usize).min(1 << 26));
     // One byte more than the limit, in case the file grew since its size was read.
-    file.take(MAX_INPUT_BYTES + 1)
+    file.take(max_bytes.saturating_add(1))
         .read_to_end(&mut bytes)
         .map_err(io)?;
-    check_size(bytes.len() as u64)?;
+    check_size(bytes.len() as u64, max_bytes)?;
     String::from_utf8(bytes).map_err(|e| {
         let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
         let line = 1 + valid.iter().filter(|&&b| b == b'\n').count();
@@ -120,13 +144,13 @@ fn read_text(path: &Path) -> Result<String, Error> {
     })
 }
 
-/// Refuses an input of `len` bytes above [`MAX_INPUT_BYTES`].
-pub(crate) fn check_size(len: u64) -> Result<(), Error> {
-    if len > MAX_INPUT_BYTES {
+/// Refuses an input of `len` bytes above `max_bytes`.
+pub(crate) fn check_size(len: u64, max_bytes: u64) -> Result<(), Error> {
+    if len > max_bytes {
         return Err(ErrorKind::LimitExceeded {
             what: "the input size in bytes".into(),
             found: len,
-            limit: MAX_INPUT_BYTES,
+            limit: max_bytes,
         }
         .into());
     }
@@ -182,7 +206,32 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let permissions = fs::metadata(path).ok().map(|m| m.permissions());
+    // Clear errors for the usual mistakes, before anything is created.
+    match fs::metadata(dir) {
+        Ok(m) if m.is_dir() => {}
+        Ok(_) => {
+            return Err(Error::new(ErrorKind::Io(format!(
+                "cannot write into {}: it is not a directory",
+                dir.display()
+            )))
+            .in_file(path))
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(Error::new(ErrorKind::Io(format!(
+                "the directory {} does not exist",
+                dir.display()
+            )))
+            .in_file(path))
+        }
+        Err(e) => return Err(fail("read the directory", e)),
+    }
+    let existing = fs::metadata(path).ok();
+    if existing.as_ref().is_some_and(|m| m.is_dir()) {
+        return Err(
+            Error::new(ErrorKind::Io("the output path is a directory".into())).in_file(path),
+        );
+    }
+    let permissions = existing.map(|m| m.permissions());
 
     let (temp_path, mut file) = loop {
         let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
@@ -196,7 +245,12 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
             Ok(f) => break (candidate, f),
             // Left over by a crashed run with the same process id: take the next name.
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && n < 1 << 20 => continue,
-            Err(e) => return Err(fail("create a temporary file", e)),
+            Err(e) => {
+                return Err(fail(
+                    &format!("create a temporary file in {}", dir.display()),
+                    e,
+                ))
+            }
         }
     };
     let result = (|| {
@@ -267,15 +321,52 @@ mod tests {
     #[test]
     fn failed_atomic_write_keeps_the_old_file() {
         let dir = tempfile::tempdir().unwrap();
-        // Renaming a file over a non-empty directory fails after the data was written.
+        // A directory at the output path is refused before anything is written.
         let target = dir.path().join("taken");
         fs::create_dir(&target).unwrap();
         fs::write(target.join("inside"), b"keep").unwrap();
-        assert!(write_atomic(&target, b"new").is_err());
+        let e = write_atomic(&target, b"new").unwrap_err();
+        assert!(
+            e.to_string().ends_with("the output path is a directory"),
+            "{e}"
+        );
         assert_eq!(fs::read(target.join("inside")).unwrap(), b"keep");
         let names: Vec<_> = fs::read_dir(dir.path()).unwrap().collect();
         assert_eq!(names.len(), 1, "the temporary file was not removed");
         // A directory that does not exist: nothing is created.
-        assert!(write_atomic(&dir.path().join("no/such/dir.json"), b"x").is_err());
+        let e = write_atomic(&dir.path().join("no/such/dir.json"), b"x").unwrap_err();
+        assert!(e.to_string().contains("no/such does not exist"), "{e}");
+        assert!(!dir.path().join("no").exists());
+        // A file where the directory should be.
+        fs::write(dir.path().join("file"), b"").unwrap();
+        let e = write_atomic(&dir.path().join("file/out.json"), b"x").unwrap_err();
+        assert!(e.to_string().contains("it is not a directory"), "{e}");
+    }
+
+    #[test]
+    #[cfg(unix)]
+    fn read_only_directory_is_a_clear_error_and_leaves_nothing() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let ro = dir.path().join("ro");
+        fs::create_dir(&ro).unwrap();
+        fs::write(ro.join("out.json"), b"old").unwrap();
+        fs::set_permissions(&ro, fs::Permissions::from_mode(0o555)).unwrap();
+        let result = write_atomic(&ro.join("out.json"), b"new");
+        let names: Vec<_> = fs::read_dir(&ro)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        let old = fs::read(ro.join("out.json")).unwrap();
+        fs::set_permissions(&ro, fs::Permissions::from_mode(0o755)).unwrap();
+        // Root may write anyway; otherwise the error names the directory and the old file stays.
+        if let Err(e) = result {
+            assert!(
+                e.to_string().contains("cannot create a temporary file in"),
+                "{e}"
+            );
+            assert_eq!(old, b"old");
+            assert_eq!(names.len(), 1, "{names:?}");
+        }
     }
 }

@@ -16,11 +16,12 @@ use kurbo::Point;
 
 use crate::colour::ColourSpace;
 use crate::error::{Error, ErrorKind};
+use crate::limits::Limits;
 use crate::mesh::{BoundaryInterpolation, ControlPoint, CreasingMethod, EdgeKind, GradientMesh};
 use crate::topology::Topology;
 use crate::validate::VertexData;
 
-use super::{check_count, check_size, error_at, syntax_error, MAX_FACES, MAX_POINTS};
+use super::{check_count, check_size, error_at, syntax_error};
 
 /// The colour given to every point of a file without vertex colours (sRGB).
 pub const NEUTRAL_GREY: [f64; 3] = [0.5, 0.5, 0.5];
@@ -88,12 +89,14 @@ fn parse_tag<'a>(t: &[&'a str], line: usize) -> Result<Tag<'a>, Error> {
     };
     let (ni, nf, ns) = (*ni, *nf, *ns);
     let args = &t[3..];
-    if args.len() != ni + nf + ns {
+    // Counts near usize::MAX must not wrap around to the number of arguments.
+    let announced = ni.checked_add(nf).and_then(|n| n.checked_add(ns));
+    if announced != Some(args.len()) {
+        let announced = announced.map_or_else(|| "more".to_string(), |n| n.to_string());
         return Err(syntax_error(
             line,
             format!(
-                "tag {name}: the counts {counts} announce {} arguments, found {}",
-                ni + nf + ns,
+                "tag {name}: the counts {counts} announce {announced} arguments, found {}",
                 args.len()
             ),
         ));
@@ -146,7 +149,13 @@ fn tag_sharpness(tag: &Tag, items: usize, k: usize, line: usize) -> Result<f64, 
 /// reader does not know, and tags it cannot honour (`hole`, smooth triangles), are errors rather
 /// than silently dropped.
 pub fn read_obj(text: &str) -> Result<GradientMesh, Error> {
-    check_size(text.len() as u64)?;
+    read_obj_with(text, &Limits::DEFAULT)
+}
+
+/// Reads an OBJ polygon mesh as [`read_obj`] does, within `limits`: input bytes, vertices, faces
+/// and corners, each refused at the line that goes beyond it.
+pub fn read_obj_with(text: &str, limits: &Limits) -> Result<GradientMesh, Error> {
+    check_size(text.len() as u64, limits.input_bytes)?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut mesh = GradientMesh::new(ColourSpace::Srgb);
     // Whether vertices carry colours, with the line of the first vertex.
@@ -156,6 +165,7 @@ pub fn read_obj(text: &str) -> Result<GradientMesh, Error> {
     // (a, b, sharpness, line) and (vertex, sharpness, line), applied at the end.
     let mut creases: Vec<(u32, u32, f64, usize)> = Vec::new();
     let mut corners: Vec<(u32, f64, usize)> = Vec::new();
+    let mut corner_count = 0u64;
 
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
@@ -173,7 +183,7 @@ pub fn read_obj(text: &str) -> Result<GradientMesh, Error> {
         match keyword {
             "v" => {
                 let v = mesh.points.len();
-                check_count("the number of vertices", v as u64 + 1, MAX_POINTS)
+                check_count("the number of vertices", v as u64 + 1, limits.points)
                     .map_err(|e| located(e, line))?;
                 let values: Vec<f64> = t[1..]
                     .iter()
@@ -222,7 +232,10 @@ pub fn read_obj(text: &str) -> Result<GradientMesh, Error> {
             }
             "f" => {
                 let f = mesh.faces.len();
-                check_count("the number of faces", f as u64 + 1, MAX_FACES)
+                check_count("the number of faces", f as u64 + 1, limits.faces)
+                    .map_err(|e| located(e, line))?;
+                corner_count += t.len() as u64 - 1;
+                check_count("the number of corners", corner_count, limits.corners)
                     .map_err(|e| located(e, line))?;
                 if t.len() < 4 {
                     return Err(syntax_error(
@@ -235,6 +248,8 @@ pub fn read_obj(text: &str) -> Result<GradientMesh, Error> {
                     ));
                 }
                 let mut face = Vec::with_capacity(t.len() - 1);
+                // A set, not a search of the corners so far: faces may have millions of corners.
+                let mut seen = std::collections::HashSet::with_capacity(t.len() - 1);
                 for (c, token) in t[1..].iter().enumerate() {
                     let first = token.split('/').next().unwrap_or("");
                     let index: i64 = first.parse().map_err(|_| {
@@ -283,7 +298,7 @@ pub fn read_obj(text: &str) -> Result<GradientMesh, Error> {
                             ),
                         ));
                     };
-                    if face.contains(&resolved) {
+                    if !seen.insert(resolved) {
                         return Err(syntax_error(
                             line,
                             format!(

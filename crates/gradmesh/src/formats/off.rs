@@ -18,9 +18,10 @@ use kurbo::{Point, Vec2};
 
 use crate::colour::ColourSpace;
 use crate::error::{Error, ErrorKind};
+use crate::limits::Limits;
 use crate::mesh::{edge_key, ControlPoint, GradientMesh};
 
-use super::{check_count, check_size, error_at, syntax_error, MAX_FACES, MAX_POINTS};
+use super::{check_count, check_size, error_at, syntax_error};
 
 /// Reservations made from declared counts are capped at this many elements; vectors grow past
 /// it as the lines are actually read.
@@ -87,11 +88,17 @@ fn parse_num(token: &str, what: &str, line: usize) -> Result<f64, Error> {
 /// Every error names the line (1-based) and says what was expected and what was found: a
 /// missing `OFF` line, counts that do not match the lines, words or non-finite values where
 /// numbers belong, indices out of range, a truncated file, text after the last face. Declared
-/// counts above [`MAX_POINTS`] or [`MAX_FACES`] are refused
-/// before anything is allocated for them. A handle towards a vertex that shares no face edge
-/// with its vertex is an error naming the vertex's line.
+/// counts above the default [`Limits`] are refused before anything is allocated for them. A
+/// handle towards a vertex that shares no face edge with its vertex is an error naming the
+/// vertex's line.
 pub fn read_off(text: &str) -> Result<GradientMesh, Error> {
-    check_size(text.len() as u64)?;
+    read_off_with(text, &Limits::DEFAULT)
+}
+
+/// Reads the authors' extended OFF as [`read_off`] does, within `limits`: input bytes, declared
+/// vertex and face counts (refused on the counts line), and corners summed over the faces.
+pub fn read_off_with(text: &str, limits: &Limits) -> Result<GradientMesh, Error> {
+    check_size(text.len() as u64, limits.input_bytes)?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut lines = Lines::new(text);
     let eof = |lines: &Lines, expected: String| {
@@ -127,8 +134,8 @@ pub fn read_off(text: &str) -> Result<GradientMesh, Error> {
     }
     let nv = parse_int(t[0], "the number of vertices", line)?;
     let nf = parse_int(t[1], "the number of faces", line)?;
-    check_count("the number of vertices", nv, MAX_POINTS).map_err(|e| located(e, line))?;
-    check_count("the number of faces", nf, MAX_FACES).map_err(|e| located(e, line))?;
+    check_count("the number of vertices", nv, limits.points).map_err(|e| located(e, line))?;
+    check_count("the number of faces", nf, limits.faces).map_err(|e| located(e, line))?;
     let colour_space = match t[2] {
         "0" => ColourSpace::Lab,
         "1" => ColourSpace::Srgb,
@@ -172,7 +179,21 @@ pub fn read_off(text: &str) -> Result<GradientMesh, Error> {
             *c = parse_num(t[3 + k], &what(&format!("colour channel {}", k + 1)), line)?;
         }
         let n = parse_int(t[6], &what("the number of neighbours n"), line)?;
-        let (short, long) = (7 + 3 * n, 8 + 4 * n);
+        if n > t.len() as u64 {
+            return Err(syntax_error(
+                line,
+                format!(
+                    "vertex {v}: the number of neighbours n = {n} is more than the {} values \
+                     of the line",
+                    t.len()
+                ),
+            ));
+        }
+        // Saturating: a huge n must not wrap around to the length of the line.
+        let (short, long) = (
+            n.saturating_mul(3).saturating_add(7),
+            n.saturating_mul(4).saturating_add(8),
+        );
         if t.len() as u64 != short && t.len() as u64 != long {
             return Err(syntax_error(
                 line,
@@ -229,6 +250,7 @@ pub fn read_off(text: &str) -> Result<GradientMesh, Error> {
     }
 
     let mut edges = HashSet::new();
+    let mut corner_count = 0u64;
     for f in 0..nf {
         let (line, t) = lines.next_tokens().ok_or_else(|| {
             eof(
@@ -243,6 +265,9 @@ pub fn read_off(text: &str) -> Result<GradientMesh, Error> {
                 format!("face {f}: expected at least 3 corners, found {k}"),
             ));
         }
+        corner_count = corner_count.saturating_add(k);
+        check_count("the number of corners", corner_count, limits.corners)
+            .map_err(|e| located(e, line))?;
         if t.len() as u64 != k + 1 {
             return Err(syntax_error(
                 line,
@@ -253,6 +278,8 @@ pub fn read_off(text: &str) -> Result<GradientMesh, Error> {
             ));
         }
         let mut corners = Vec::with_capacity(t.len() - 1);
+        // A set, not a search of the corners so far: faces may have millions of corners.
+        let mut seen_corners = HashSet::with_capacity(t.len() - 1);
         for (c, token) in t[1..].iter().enumerate() {
             let i = parse_int(token, &format!("face {f}: corner {c}"), line)?;
             if i >= nv as u64 {
@@ -266,7 +293,7 @@ pub fn read_off(text: &str) -> Result<GradientMesh, Error> {
                     },
                 ));
             }
-            if corners.contains(&(i as u32)) {
+            if !seen_corners.insert(i) {
                 return Err(error_at(
                     line,
                     ErrorKind::DegenerateFace {

@@ -1,0 +1,128 @@
+//! `gradmesh render`: the limit surface of every layer, to a PNG.
+
+use std::time::Instant;
+
+use gradmesh::colour::parse_css_colour;
+use gradmesh::formats;
+use gradmesh::render::{self, GamutMapping, RenderOptions, View};
+use gradmesh::{ColourSpace, Document, Error, ErrorKind};
+
+use crate::args::RenderArgs;
+
+fn invalid(what: &str, message: String) -> Error {
+    Error::new(ErrorKind::Invalid {
+        what: what.into(),
+        message,
+    })
+}
+
+/// Turns the flags into render options for `doc`.
+fn options(args: &RenderArgs, doc: &Document) -> Result<RenderOptions, Error> {
+    let view = match &args.view {
+        Some(v) => View::new(v[0], v[1], v[2], v[3]),
+        None => View::fit(doc, 0.0),
+    };
+    if !(view.width() > 0.0 && view.height() > 0.0) {
+        return Err(invalid(
+            "--view",
+            format!("X1 must exceed X0 and Y1 must exceed Y0, found {view:?}"),
+        ));
+    }
+    let aspect = view.width() / view.height();
+    let side = |x: f64| (x.round().max(1.0)).min(u32::MAX as f64) as u32;
+    let (width, height) = match (args.width, args.height) {
+        (Some(w), Some(h)) => (w, h),
+        (Some(w), None) => (w, side(w as f64 / aspect)),
+        (None, Some(h)) => (side(h as f64 * aspect), h),
+        // One pixel per unit of the plane.
+        (None, None) => (side(view.width()), side(view.height())),
+    };
+    let mut opts = RenderOptions::new(width, height, view);
+    if let Some(bg) = &args.background {
+        let (rgb, alpha) = parse_css_colour(bg, ColourSpace::Srgb)
+            .map_err(|e| invalid("--background", format!("{bg:?}: {e}")))?;
+        opts.background = Some([rgb[0], rgb[1], rgb[2], alpha]);
+    }
+    if let Some(name) = &args.colour_space {
+        opts.colour_space_override = Some(ColourSpace::from_name(name).ok_or_else(|| {
+            invalid(
+                "--colour-space",
+                format!("expected lab, oklab, srgb-linear or srgb, found {name:?}"),
+            )
+        })?);
+    }
+    if let Some(name) = &args.gamut {
+        opts.gamut = GamutMapping::from_name(name).ok_or_else(|| {
+            invalid(
+                "--gamut",
+                format!("expected chroma or clip, found {name:?}"),
+            )
+        })?;
+    }
+    opts.reference = args.reference;
+    opts.level = args.level;
+    opts.dither = !args.no_dither;
+    Ok(opts)
+}
+
+pub fn run(args: &RenderArgs) -> Result<(), Error> {
+    if formats::Format::from_path(&args.output).is_some()
+        || args
+            .output
+            .extension()
+            .is_none_or(|e| !e.eq_ignore_ascii_case("png"))
+    {
+        return Err(invalid(
+            "output",
+            format!("{}: render writes .png", args.output.display()),
+        ));
+    }
+    let inputs: Vec<&std::path::Path> = args.inputs.iter().map(|p| p.as_path()).collect();
+    super::check_not_input(&args.output, &inputs, args.force)?;
+
+    let start = Instant::now();
+    let mut doc = Document::default();
+    let limits = args.limits.limits();
+    for path in &args.inputs {
+        doc.layers.extend(super::read(path, &limits)?.layers);
+    }
+    let read = start.elapsed();
+
+    let opts = options(args, &doc)?;
+    let start = Instant::now();
+    let (mut image, info) = render::render_image(&doc, &opts)?;
+    let rendered = start.elapsed();
+    for w in &info.warnings {
+        eprintln!("gradmesh: warning: {w}");
+    }
+    if args.boundary {
+        render::draw_outlines(&doc, &opts, &mut image)?;
+    }
+
+    let start = Instant::now();
+    let png = render::encode_png(&image, args.bits, opts.dither)?;
+    formats::write_atomic(&args.output, &png)?;
+    let written = start.elapsed();
+
+    if args.timings {
+        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+        eprintln!("read       {:9.2} ms", ms(read));
+        eprintln!(
+            "render     {:9.2} ms ({}x{})",
+            ms(rendered),
+            opts.width,
+            opts.height
+        );
+        eprintln!("encode     {:9.2} ms", ms(written));
+        for (i, l) in info.layers.iter().enumerate() {
+            eprintln!(
+                "layer {i}: level {}{}, {} quads, {} triangles drawn",
+                l.level,
+                if l.capped { " (capped)" } else { "" },
+                l.quads,
+                l.triangles
+            );
+        }
+    }
+    Ok(())
+}

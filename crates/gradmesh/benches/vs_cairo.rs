@@ -1,0 +1,145 @@
+//! gradmesh against Cairo's mesh pattern (the renderer behind Inkscape's mesh gradients), and
+//! against the memory-bandwidth floor (filling the same RGBA buffer with one colour).
+//!
+//! The scene: a rectangular 4x4-point mesh with curved edges, 9 patches, at 1024x1024. Cairo
+//! paints the same 9 patches as Coons patches whose edges are the cubic Béziers through the
+//! control points with their handles (as Illustrator's mesh).
+//!
+//! Run: `apt-get install libcairo2-dev` then
+//! `cargo bench -p gradmesh --features cairo-bench --bench vs_cairo`.
+
+#![allow(missing_docs)] // criterion_group! generates undocumented items.
+
+use std::time::Duration;
+
+use cairo::{Context, Format, ImageSurface, Mesh, MeshCorner};
+use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use gradmesh::render::{render_document_into, RenderOptions, View};
+use gradmesh::{ColourSpace, Document, GradientMesh};
+use kurbo::{Point, Vec2};
+
+const SIZE: u32 = 1024;
+const N: usize = 4;
+
+/// Control points of the 4x4 grid, with wavy positions, in a 1024-unit square.
+fn grid() -> Vec<Point> {
+    let mut p = Vec::new();
+    for j in 0..N {
+        for i in 0..N {
+            let (x, y) = (40.0 + 944.0 * i as f64 / 3.0, 40.0 + 944.0 * j as f64 / 3.0);
+            p.push(Point::new(
+                x + 30.0 * (y / 160.0).sin(),
+                y + 25.0 * (x / 190.0).sin(),
+            ));
+        }
+    }
+    p
+}
+
+fn colour(i: usize, j: usize) -> [f64; 3] {
+    let t = (i * 7 + j * 3) as f64;
+    [
+        0.5 + 0.5 * (t * 0.9).sin(),
+        0.5 + 0.5 * (t * 1.3 + 1.0).sin(),
+        0.5 + 0.5 * (t * 0.7 + 2.0).sin(),
+    ]
+}
+
+/// The handle of grid point `a` towards `b`, bent a little so that edges are curved.
+fn handle(p: &[Point], a: usize, b: usize) -> Vec2 {
+    let d = (p[b] - p[a]) / 3.0;
+    Vec2::new(d.x - 0.15 * d.y, d.y + 0.15 * d.x)
+}
+
+fn document() -> Document {
+    let p = grid();
+    let mut m = GradientMesh::new(ColourSpace::Srgb);
+    for j in 0..N {
+        for i in 0..N {
+            m.add_point(p[j * N + i], colour(i, j));
+        }
+    }
+    for j in 0..N - 1 {
+        for i in 0..N - 1 {
+            let v = (j * N + i) as u32;
+            m.add_face(vec![v, v + 1, v + 1 + N as u32, v + N as u32]);
+        }
+    }
+    let faces = m.faces.clone();
+    for f in &faces {
+        for k in 0..4 {
+            let (a, b) = (f[k] as usize, f[(k + 1) % 4] as usize);
+            m.set_handle(a as u32, b as u32, handle(&p, a, b));
+            m.set_handle(b as u32, a as u32, handle(&p, b, a));
+        }
+    }
+    Document { layers: vec![m] }
+}
+
+fn cairo_mesh() -> Mesh {
+    let p = grid();
+    let mesh = Mesh::new();
+    let corners = [
+        MeshCorner::MeshCorner0,
+        MeshCorner::MeshCorner1,
+        MeshCorner::MeshCorner2,
+        MeshCorner::MeshCorner3,
+    ];
+    for j in 0..N - 1 {
+        for i in 0..N - 1 {
+            let idx = [
+                j * N + i,
+                j * N + i + 1,
+                (j + 1) * N + i + 1,
+                (j + 1) * N + i,
+            ];
+            let cells = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
+            mesh.begin_patch();
+            mesh.move_to(p[idx[0]].x, p[idx[0]].y);
+            for k in 0..4 {
+                let (a, b) = (idx[k], idx[(k + 1) % 4]);
+                let (c1, c2) = (p[a] + handle(&p, a, b), p[b] + handle(&p, b, a));
+                mesh.curve_to(c1.x, c1.y, c2.x, c2.y, p[b].x, p[b].y);
+            }
+            for k in 0..4 {
+                let c = colour(cells[k].0, cells[k].1);
+                mesh.set_corner_color_rgb(corners[k], c[0], c[1], c[2]);
+            }
+            mesh.end_patch();
+        }
+    }
+    mesh
+}
+
+fn bench(c: &mut Criterion) {
+    let doc = document();
+    let mut opts = RenderOptions::new(SIZE, SIZE, View::new(0.0, 0.0, SIZE as f64, SIZE as f64));
+    opts.dither = false;
+    let mut buffer = vec![0u8; 4 * (SIZE * SIZE) as usize];
+    let mesh = cairo_mesh();
+    let surface = ImageSurface::create(Format::ARgb32, SIZE as i32, SIZE as i32).unwrap();
+
+    let mut g = c.benchmark_group("vs_cairo_1024");
+    g.sample_size(20).measurement_time(Duration::from_secs(8));
+    g.bench_function("gradmesh", |b| {
+        b.iter(|| render_document_into(black_box(&doc), &opts, &mut buffer).unwrap())
+    });
+    g.bench_function("cairo_mesh_pattern", |b| {
+        b.iter(|| {
+            let cr = Context::new(&surface).unwrap();
+            cr.set_source(black_box(&mesh)).unwrap();
+            cr.paint().unwrap();
+        })
+    });
+    g.bench_function("fill_one_colour_floor", |b| {
+        b.iter(|| {
+            for px in buffer.chunks_exact_mut(4) {
+                px.copy_from_slice(black_box(&[200, 100, 50, 255]));
+            }
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

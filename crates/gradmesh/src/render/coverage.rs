@@ -1,0 +1,253 @@
+//! Exact area coverage of a closed outline, by signed-area accumulation (the method of font
+//! rasterisers such as font-rs and stb_truetype).
+//!
+//! Every line segment adds, to each pixel of each row it crosses, the signed area of the part of
+//! that pixel lying to its right, stored as a difference from the pixel on its left; a prefix sum
+//! along the row then gives the winding-weighted area of every pixel. Loops of opposite
+//! orientation (an outer boundary and a hole) subtract, a segment run once in each direction
+//! (the two sides of a discontinuous edge) cancels, and the magnitude is clamped to 1.
+//!
+//! Rows are independent: a band of rows is accumulated from the segments that cross it alone,
+//! with the same arithmetic whichever band or thread does it.
+
+/// A directed line segment in pixel coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Line {
+    pub p0: [f64; 2],
+    pub p1: [f64; 2],
+}
+
+impl Line {
+    /// The rows `[first, last)` whose interior the segment may touch.
+    pub fn rows(&self) -> (i64, i64) {
+        let (lo, hi) = if self.p0[1] < self.p1[1] {
+            (self.p0[1], self.p1[1])
+        } else {
+            (self.p1[1], self.p0[1])
+        };
+        (lo.floor() as i64, hi.ceil() as i64)
+    }
+}
+
+/// Adds the contribution of `line` to the accumulation rows `row0 .. row0 + rows` of width
+/// `width` (each accumulation row holds `width + 2` cells).
+pub(crate) fn accumulate(acc: &mut [f64], width: usize, row0: i64, rows: usize, line: &Line) {
+    let ([x0, y0], [x1, y1], dir) = if line.p0[1] < line.p1[1] {
+        (line.p0, line.p1, 1.0)
+    } else if line.p0[1] > line.p1[1] {
+        (line.p1, line.p0, -1.0)
+    } else {
+        return;
+    };
+    let stride = width + 2;
+    let dxdy = (x1 - x0) / (y1 - y0);
+    let first = (y0.floor() as i64).max(row0);
+    let last = (y1.ceil() as i64).min(row0 + rows as i64);
+    for j in first..last {
+        let ya = y0.max(j as f64);
+        let yb = y1.min((j + 1) as f64);
+        if yb <= ya {
+            continue;
+        }
+        // Ends computed from the segment, not incrementally: the same in every band.
+        let xa = if ya == y0 { x0 } else { x0 + (ya - y0) * dxdy };
+        let xb = if yb == y1 { x1 } else { x0 + (yb - y0) * dxdy };
+        let start = (j - row0) as usize * stride;
+        add_piece(
+            &mut acc[start..start + stride],
+            width as f64,
+            xa,
+            xb,
+            dir * (yb - ya),
+        );
+    }
+}
+
+/// Adds one piece of a segment within one row: from `xa` to `xb`, spanning `d` (signed) of the
+/// row's height. Parts left of the image count fully for every pixel; parts right of it for none.
+fn add_piece(row: &mut [f64], width: f64, xa: f64, xb: f64, d: f64) {
+    let (lo, hi) = if xa <= xb { (xa, xb) } else { (xb, xa) };
+    if hi <= 0.0 || lo >= width || hi - lo < 1e-9 {
+        let x = (0.5 * (xa + xb)).clamp(0.0, width);
+        add_span(row, x, x, d);
+        return;
+    }
+    // Split at the image's left and right edges, sharing `d` in proportion to length.
+    let len = hi - lo;
+    let mut cuts = [lo, lo.max(0.0), hi.min(width), hi];
+    cuts.iter_mut().for_each(|c| *c = c.clamp(lo, hi));
+    for k in 0..3 {
+        let (a, b) = (cuts[k], cuts[k + 1]);
+        if b <= a {
+            continue;
+        }
+        let part = d * (b - a) / len;
+        let (a, b) = (a.clamp(0.0, width), b.clamp(0.0, width));
+        add_span(row, a, b, part);
+    }
+}
+
+/// Adds a monotone piece from `x0` to `x1` (`x0 <= x1`, both in `0..=width`) spanning `d`.
+fn add_span(row: &mut [f64], x0: f64, x1: f64, d: f64) {
+    let c0 = x0.floor() as usize;
+    if x1 - x0 < 1e-9 {
+        // Vertical: the area right of x in cell c0 is c0 + 1 - x.
+        let f = (c0 as f64 + 1.0 - x0).clamp(0.0, 1.0);
+        row[c0] += d * f;
+        row[c0 + 1] += d * (1.0 - f);
+        return;
+    }
+    let c1 = x1.ceil() as usize;
+    let s = d / (x1 - x0);
+    // A(c) = s * integral over [x0, x1] of clamp(c + 1 - x, 0, 1), by the antiderivative
+    // H(u) of clamp(1 - u, 0, 1) with u = x - c, taken relative to each cell to keep precision.
+    let h = |u: f64| -> f64 {
+        if u <= 0.0 {
+            u
+        } else if u >= 1.0 {
+            0.5
+        } else {
+            u - 0.5 * u * u
+        }
+    };
+    let mut prev = 0.0;
+    for c in c0..=c1.min(row.len() - 1) {
+        let cf = c as f64;
+        let a = if c == c1 {
+            d
+        } else {
+            s * (h(x1 - cf) - h(x0 - cf))
+        };
+        row[c] += a - prev;
+        prev = a;
+    }
+}
+
+/// Turns one accumulation row into coverage in `0..=1` by a prefix sum, writing `width` values.
+pub(crate) fn resolve_row(acc: &[f64], out: &mut [f32]) {
+    let mut sum = 0.0;
+    for (o, &a) in out.iter_mut().zip(acc) {
+        sum += a;
+        let c = sum.abs().min(1.0);
+        // Round-off of cancelled contributions is not coverage.
+        *o = if c < 1e-9 {
+            0.0
+        } else if c > 1.0 - 1e-9 {
+            1.0
+        } else {
+            c as f32
+        };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn render(lines: &[Line], w: usize, h: usize) -> Vec<f32> {
+        let mut acc = vec![0.0; (w + 2) * h];
+        for l in lines {
+            accumulate(&mut acc, w, 0, h, l);
+        }
+        let mut out = vec![0.0; w * h];
+        for j in 0..h {
+            resolve_row(
+                &acc[j * (w + 2)..(j + 1) * (w + 2)],
+                &mut out[j * w..(j + 1) * w],
+            );
+        }
+        out
+    }
+
+    fn polygon(pts: &[[f64; 2]]) -> Vec<Line> {
+        (0..pts.len())
+            .map(|i| Line {
+                p0: pts[i],
+                p1: pts[(i + 1) % pts.len()],
+            })
+            .collect()
+    }
+
+    /// Area of the intersection of a convex polygon with the pixel square (Sutherland-Hodgman).
+    fn exact(pts: &[[f64; 2]], i: usize, j: usize) -> f64 {
+        let mut poly: Vec<[f64; 2]> = pts.to_vec();
+        let (x0, y0) = (i as f64, j as f64);
+        let planes: [(usize, f64, f64); 4] = [
+            (0, x0, 1.0),
+            (0, x0 + 1.0, -1.0),
+            (1, y0, 1.0),
+            (1, y0 + 1.0, -1.0),
+        ];
+        for (axis, v, sign) in planes {
+            let inside = |p: &[f64; 2]| (p[axis] - v) * sign >= 0.0;
+            let mut out = Vec::new();
+            for k in 0..poly.len() {
+                let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+                if inside(&a) {
+                    out.push(a);
+                }
+                if inside(&a) != inside(&b) {
+                    let t = (v - a[axis]) / (b[axis] - a[axis]);
+                    out.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
+                }
+            }
+            poly = out;
+            if poly.is_empty() {
+                return 0.0;
+            }
+        }
+        let mut area = 0.0;
+        for k in 0..poly.len() {
+            let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+            area += a[0] * b[1] - b[0] * a[1];
+        }
+        0.5 * area.abs()
+    }
+
+    #[test]
+    fn triangle_coverage_is_exact() {
+        let pts = [[1.3, 0.7], [13.9, 4.2], [4.1, 11.6]];
+        let (w, h) = (16, 14);
+        let cov = render(&polygon(&pts), w, h);
+        for j in 0..h {
+            for i in 0..w {
+                let e = exact(&pts, i, j);
+                assert!((cov[j * w + i] as f64 - e).abs() < 1e-6, "{i} {j}");
+            }
+        }
+        // Reversed orientation: the same magnitude.
+        let mut rev = pts;
+        rev.reverse();
+        assert_eq!(render(&polygon(&rev), w, h), cov);
+    }
+
+    #[test]
+    fn clipped_at_image_edges() {
+        // A square sticking out on every side of a 6x5 image.
+        let pts = [[-3.5, -2.25], [8.5, -2.25], [8.5, 7.5], [-3.5, 7.5]];
+        let cov = render(&polygon(&pts), 6, 5);
+        assert!(cov.iter().all(|&c| c == 1.0), "{cov:?}");
+        let pts = [[-3.0, 1.5], [2.5, 1.5], [2.5, 3.0], [-3.0, 3.0]];
+        let cov = render(&polygon(&pts), 6, 5);
+        assert_eq!(&cov[6..12], &[0.5, 0.5, 0.25, 0.0, 0.0, 0.0]);
+        assert_eq!(&cov[12..18], &[1.0, 1.0, 0.5, 0.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn holes_and_cancelled_edges() {
+        let outer = [[0.5, 0.5], [9.5, 0.5], [9.5, 9.5], [0.5, 9.5]];
+        let hole = [[3.0, 3.0], [3.0, 7.0], [7.0, 7.0], [7.0, 3.0]];
+        let mut lines = polygon(&outer);
+        lines.extend(polygon(&hole));
+        let cov = render(&lines, 10, 10);
+        assert_eq!(cov[5 * 10 + 5], 0.0);
+        assert_eq!(cov[2 * 10 + 2], 1.0);
+        // Two halves sharing a slanted edge, run once each way: no seam.
+        let left = [[0.0, 0.0], [6.3, 0.0], [3.7, 10.0], [0.0, 10.0]];
+        let right = [[6.3, 0.0], [10.0, 0.0], [10.0, 10.0], [3.7, 10.0]];
+        let mut lines = polygon(&left);
+        lines.extend(polygon(&right));
+        let cov = render(&lines, 10, 10);
+        assert!(cov.iter().all(|&c| c == 1.0), "{cov:?}");
+    }
+}

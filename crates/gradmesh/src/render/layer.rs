@@ -1,0 +1,554 @@
+//! One layer made ready to draw: refinement level chosen, limit data tessellated into
+//! triangles, outline flattened, everything binned into bands of rows.
+
+use rayon::prelude::*;
+
+use crate::colour::ColourSpace;
+use crate::error::{Error, Warning};
+use crate::limit;
+use crate::mesh::GradientMesh;
+use crate::refine::{RefinedMesh, Refinement};
+use crate::topology::Topology;
+use crate::validate::VertexData;
+
+use super::coverage::Line;
+use super::nearest::{NearestSegments, Segment};
+use super::outline::{boundary_loops, outline};
+use super::triangles::{snap, Triangle, SUBPIXEL};
+use super::view::ToPixels;
+use super::{LayerInfo, RenderOptions};
+
+/// Rows per band: the unit of parallel work.
+pub(crate) const BAND: usize = 16;
+
+/// Reference mode: quads at most this wide (diagonal, pixels)...
+const REFERENCE_QUAD_PX: f64 = 0.5;
+/// ...the boundary edges within this distance of the outline (pixels)...
+const REFERENCE_TOLERANCE_PX: f64 = 0.01;
+/// ...and the colours within this (approximately Delta E)...
+const REFERENCE_COLOUR_TOLERANCE: f64 = 0.002;
+/// ...counted in quads at least this wide (pixels).
+const REFERENCE_MIN_QUAD_PX: f64 = 0.1;
+/// Colour errors count in quads at least this wide (diagonal, pixels) in the fast path.
+const MIN_QUAD_PX: f64 = 1.0;
+/// Flattening tolerance of the outline (pixels): coverage error at most this per pixel.
+const OUTLINE_TOLERANCE_PX: f64 = 0.002;
+const REFERENCE_OUTLINE_TOLERANCE_PX: f64 = 0.0002;
+
+/// Item indices grouped by band (compressed rows).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Bins {
+    offsets: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl Bins {
+    /// Bins items given as `(index, first band, last band inclusive)`, keeping index order
+    /// within each band.
+    fn new(bands: usize, ranges: &[(u32, usize, usize)]) -> Bins {
+        let mut offsets = vec![0u32; bands + 1];
+        for &(_, a, b) in ranges {
+            for band in a..=b {
+                offsets[band + 1] += 1;
+            }
+        }
+        for k in 0..bands {
+            offsets[k + 1] += offsets[k];
+        }
+        let mut fill = offsets.clone();
+        let mut items = vec![0u32; offsets[bands] as usize];
+        for &(i, a, b) in ranges {
+            for band in a..=b {
+                items[fill[band] as usize] = i;
+                fill[band] += 1;
+            }
+        }
+        Bins { offsets, items }
+    }
+
+    pub fn get(&self, band: usize) -> &[u32] {
+        &self.items[self.offsets[band] as usize..self.offsets[band + 1] as usize]
+    }
+}
+
+/// Everything needed to draw one layer.
+pub(crate) struct PreparedLayer {
+    pub space: ColourSpace,
+    pub triangles: Vec<Triangle>,
+    pub triangle_bins: Bins,
+    pub lines: Vec<Line>,
+    pub line_bins: Bins,
+    pub nearest: NearestSegments,
+    /// Columns `[start, end)` where coverage can be non-zero.
+    pub columns: (usize, usize),
+}
+
+/// The mesh with its colours converted to `space` (so that they are interpolated there).
+fn in_space(mesh: &GradientMesh, space: ColourSpace) -> GradientMesh {
+    let mut m = mesh.clone();
+    if space == mesh.colour_space {
+        return m;
+    }
+    for p in &mut m.points {
+        p.colour = mesh.colour_space.convert(space, p.colour);
+        p.colour_text = None;
+    }
+    for w in &mut m.wedges {
+        w.colour = mesh.colour_space.convert(space, w.colour);
+        w.colour_text = None;
+    }
+    m.colour_space = space;
+    m
+}
+
+/// The result of choosing a level.
+struct Choice {
+    level: usize,
+    capped: bool,
+    measured: Option<Measure>,
+    /// Whether `measured` is a prediction from the level above.
+    estimated: bool,
+}
+
+/// How well the triangles of one level render the limit surface, over the quads that reach
+/// the image.
+#[derive(Clone, Copy, Debug, Default)]
+struct Measure {
+    /// Largest quad diagonal, pixels.
+    extent: f64,
+    /// Largest colour error, approximately CIE Lab units (opacity counts 100 per unit).
+    colour: f64,
+    /// Largest distance of the outline from the triangles' boundary edges, pixels.
+    outline: f64,
+}
+
+/// A colour difference in approximately CIE Lab units (Delta E 1976), opacity included.
+fn colour_error(space: ColourSpace, a: [f64; 4], b: [f64; 4]) -> f64 {
+    let d = |x: [f64; 3], y: [f64; 3]| {
+        ((x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + (x[2] - y[2]).powi(2)).sqrt()
+    };
+    let (ca, cb) = ([a[0], a[1], a[2]], [b[0], b[1], b[2]]);
+    let colour = match space {
+        ColourSpace::Lab => d(ca, cb),
+        ColourSpace::Oklab => 100.0 * d(ca, cb),
+        _ => d(
+            space.convert(ColourSpace::Lab, ca),
+            space.convert(ColourSpace::Lab, cb),
+        ),
+    };
+    colour.max(100.0 * (a[3] - b[3]).abs())
+}
+
+/// The attributes a triangle `p` with attributes `c` shows at `x`: linear inside, and at the
+/// nearest point of its sides outside (so that thin or folded triangles, whose planes are
+/// ill-conditioned, give bounded answers).
+fn interpolate(p: [[f64; 2]; 3], c: [[f64; 4]; 3], x: [f64; 2]) -> [f64; 4] {
+    let (e1, e2) = (
+        [p[1][0] - p[0][0], p[1][1] - p[0][1]],
+        [p[2][0] - p[0][0], p[2][1] - p[0][1]],
+    );
+    let det = e1[0] * e2[1] - e1[1] * e2[0];
+    let scale = (e1[0] * e1[0] + e1[1] * e1[1]).max(e2[0] * e2[0] + e2[1] * e2[1]);
+    if det.abs() > 1e-9 * scale {
+        let (dx, dy) = (x[0] - p[0][0], x[1] - p[0][1]);
+        let u = (dx * e2[1] - dy * e2[0]) / det;
+        let v = (e1[0] * dy - e1[1] * dx) / det;
+        if u >= 0.0 && v >= 0.0 && u + v <= 1.0 {
+            return [0, 1, 2, 3]
+                .map(|k| c[0][k] + u * (c[1][k] - c[0][k]) + v * (c[2][k] - c[0][k]));
+        }
+    }
+    let mut best = (f64::INFINITY, c[0]);
+    for k in 0..3 {
+        let (a, b) = (p[k], p[(k + 1) % 3]);
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let len2 = dx * dx + dy * dy;
+        let t = if len2 > 0.0 {
+            (((x[0] - a[0]) * dx + (x[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let d2 = (x[0] - a[0] - t * dx).powi(2) + (x[1] - a[1] - t * dy).powi(2);
+        if d2 < best.0 {
+            let (ca, cb) = (c[k], c[(k + 1) % 3]);
+            best = (d2, [0, 1, 2, 3].map(|i| ca[i] + t * (cb[i] - ca[i])));
+        }
+    }
+    best.1
+}
+
+/// Measures level `k` of a layer. `lim` holds the limit data of level `k`, `lim1` that of
+/// level `k + 1`: its face point `f` and edge point `nf + e` are the surface at the centres of
+/// face `f` and edge `e` of level `k`, in position and colour.
+///
+/// The colour error is what a pixel shows: the limit colour at a centre's true position against
+/// the colour the triangles interpolate at that same position (not at the same parameter: the
+/// map from the mesh to the plane is not affine within a quad, and that displacement times the
+/// colour gradient is usually the larger term). The outline distance is the deviation of the
+/// limit boundary from the boundary edges, across the edge.
+///
+/// Colour errors inside quads less than `min_quad` pixels across are not counted: such a quad
+/// holds at most a pixel centre or two. Errors that survive refinement that far sit at
+/// extraordinary and degenerate points (a handle of length zero makes a sharp colour step, for
+/// example), where uniform refinement converges only linearly and would refine the whole layer
+/// for a few pixels.
+fn measure(
+    t: &Topology,
+    lim: &[VertexData],
+    lim1: &[VertexData],
+    xf: &ToPixels,
+    size: (f64, f64),
+    space: ColourSpace,
+    min_quad: f64,
+) -> Measure {
+    let nf = t.face_count();
+    let px = |d: &VertexData| xf.apply(d[0], d[1]);
+    let attr = |d: &VertexData| [d[2], d[3], d[4], d[5]];
+    let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    // Per face, then the largest of each figure: max is exact, so any split gives the same.
+    let face = |f: usize| -> Measure {
+        let mut m = Measure::default();
+        let fv = t.face_vertices(f);
+        if fv.len() != 4 {
+            return m;
+        }
+        let p = [0, 1, 2, 3].map(|i| px(&lim[fv[i] as usize]));
+        let c = [0, 1, 2, 3].map(|i| attr(&lim[fv[i] as usize]));
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for q in &p {
+            for k in 0..2 {
+                lo[k] = lo[k].min(q[k]);
+                hi[k] = hi[k].max(q[k]);
+            }
+        }
+        if hi[0] < -1.0 || hi[1] < -1.0 || lo[0] > size.0 + 1.0 || lo[1] > size.1 + 1.0 {
+            return m;
+        }
+        let extent = dist(p[0], p[2]).max(dist(p[1], p[3]));
+        m.extent = m.extent.max(extent);
+        let tris = [[0, 1, 2], [0, 2, 3]];
+        let counts = extent >= min_quad;
+        let check = |m: &mut Measure, sample: &VertexData, tri: usize| {
+            if !counts {
+                return;
+            }
+            let shown = interpolate(tris[tri].map(|i| p[i]), tris[tri].map(|i| c[i]), px(sample));
+            m.colour = m.colour.max(colour_error(space, attr(sample), shown));
+        };
+        // The quad's centre lies on the shared diagonal: both triangles.
+        check(&mut m, &lim1[f], 0);
+        check(&mut m, &lim1[f], 1);
+        for (k, &e) in t.face_edges(f).iter().enumerate() {
+            let sample = &lim1[nf + e as usize];
+            check(&mut m, sample, if k < 2 { 0 } else { 1 });
+            if t.is_boundary_edge(e as usize) {
+                let (a, b) = (p[k], p[(k + 1) % 4]);
+                let x = px(sample);
+                let len = dist(a, b);
+                let off = if len > 0.0 {
+                    ((b[0] - a[0]) * (x[1] - a[1]) - (b[1] - a[1]) * (x[0] - a[0])).abs() / len
+                } else {
+                    dist(a, x)
+                };
+                m.outline = m.outline.max(off);
+            }
+        }
+        m
+    };
+    (0..nf)
+        .into_par_iter()
+        .map(face)
+        .reduce(Measure::default, |a, b| Measure {
+            extent: a.extent.max(b.extent),
+            colour: a.colour.max(b.colour),
+            outline: a.outline.max(b.outline),
+        })
+}
+
+/// The limit data of level `k >= 2` (all quads), without copying the level's data.
+fn limit_of(refinement: &mut Refinement, data: &RefinedMesh, k: usize) -> Vec<VertexData> {
+    match limit::limit_stencils(refinement.level(k)) {
+        Some(st) => st.apply(&data.levels[k]),
+        None => refinement.limit(data, k),
+    }
+}
+
+/// Refines until the triangles of the quads that reach the image show the limit colours within
+/// [`RenderOptions::colour_tolerance`], their quads are at most [`RenderOptions::max_quad_px`]
+/// across, and the boundary edges lie within [`RenderOptions::tolerance_px`] of the outline (or
+/// until a cap is reached). Colour errors in quads under [`MIN_QUAD_PX`] are not counted (see
+/// [`measure`]).
+///
+/// Level 2 is the first all-quad level. Measuring level `k` needs level `k + 1`. When level `k`
+/// fails but would pass with its errors halved (colour and size halve at least per level; the
+/// outline's distance quarters), level `k + 1`, already built, is drawn, so in most cases no level
+/// beyond the drawn one is built. Returns the choice and the limit data of the chosen level.
+fn choose_level(
+    refinement: &mut Refinement,
+    data: &mut RefinedMesh,
+    xf: &ToPixels,
+    opts: &RenderOptions,
+    space: ColourSpace,
+) -> (Choice, Vec<VertexData>) {
+    let (quad, tol, colour_tol, min_quad) = if opts.reference {
+        (
+            opts.max_quad_px.min(REFERENCE_QUAD_PX),
+            opts.tolerance_px.min(REFERENCE_TOLERANCE_PX),
+            opts.colour_tolerance.min(REFERENCE_COLOUR_TOLERANCE),
+            REFERENCE_MIN_QUAD_PX,
+        )
+    } else {
+        (
+            opts.max_quad_px,
+            opts.tolerance_px,
+            opts.colour_tolerance,
+            MIN_QUAD_PX,
+        )
+    };
+    let size = (opts.width as f64, opts.height as f64);
+    let extend = |refinement: &mut Refinement, data: &mut RefinedMesh, k: usize| {
+        while data.levels.len() <= k {
+            let j = data.levels.len() - 1;
+            refinement.extend_to(j + 1);
+            let next = refinement.stencils(j).apply(&data.levels[j]);
+            data.levels.push(next);
+        }
+    };
+    if let Some(forced) = opts.level {
+        let k = forced.max(2);
+        extend(refinement, data, k);
+        let lim = limit_of(refinement, data, k);
+        let choice = Choice {
+            level: k,
+            capped: false,
+            measured: None,
+            estimated: false,
+        };
+        return (choice, lim);
+    }
+    let passes = |m: &Measure| m.extent <= quad && m.colour <= colour_tol && m.outline <= tol;
+    let mut k = 2;
+    let mut lim = limit_of(refinement, data, k);
+    let mut last: Option<Measure> = None;
+    loop {
+        let next_faces = refinement.topology(k).corner_count();
+        if next_faces > opts.max_quads || k + 1 > opts.max_level.max(2) {
+            let choice = Choice {
+                level: k,
+                capped: true,
+                measured: last,
+                estimated: true,
+            };
+            return (choice, lim);
+        }
+        extend(refinement, data, k + 1);
+        let lim1 = limit_of(refinement, data, k + 1);
+        let m = measure(
+            refinement.topology(k),
+            &lim,
+            &lim1,
+            xf,
+            size,
+            space,
+            min_quad,
+        );
+        if passes(&m) {
+            let choice = Choice {
+                level: k,
+                capped: false,
+                measured: Some(m),
+                estimated: false,
+            };
+            return (choice, lim);
+        }
+        let predicted = Measure {
+            extent: 0.5 * m.extent,
+            colour: 0.5 * m.colour,
+            outline: 0.25 * m.outline,
+        };
+        if passes(&predicted) {
+            let choice = Choice {
+                level: k + 1,
+                capped: false,
+                measured: Some(predicted),
+                estimated: true,
+            };
+            return (choice, lim1);
+        }
+        last = Some(predicted);
+        k += 1;
+        lim = lim1;
+    }
+}
+
+/// What [`prepare`] returns: the layer's description, the layer ready to draw (`None` when
+/// nothing of it reaches the image) and the warnings of its validation.
+pub(crate) type Prepared = (LayerInfo, Option<PreparedLayer>, Vec<Warning>);
+
+/// Prepares layer `index` of a document for drawing.
+pub(crate) fn prepare(
+    mesh: &GradientMesh,
+    index: usize,
+    opts: &RenderOptions,
+    xf: &ToPixels,
+) -> Result<Prepared, Error> {
+    if mesh.faces.is_empty() {
+        return Ok((LayerInfo::default(), None, Vec::new()));
+    }
+    let space = opts.colour_space_override.unwrap_or(mesh.colour_space);
+    let mesh = in_space(mesh, space);
+    let (mut refinement, warnings) = Refinement::new(&mesh, 2).map_err(|e| e.in_layer(index))?;
+    let warnings = warnings
+        .into_iter()
+        .map(|w| Warning {
+            layer: Some(index),
+            ..w
+        })
+        .collect();
+    let mut data = refinement.evaluate();
+    let (choice, lim) = choose_level(&mut refinement, &mut data, xf, opts, space);
+    let k = choice.level;
+    let t = refinement.topology(k);
+    let (w, h) = (opts.width as i64, opts.height as i64);
+    let bands = (opts.height as usize).div_ceil(BAND);
+
+    // Triangles, in face order (the draw order where the surface folds over itself).
+    let exact: Vec<[f64; 2]> = lim.iter().map(|d| xf.apply(d[0], d[1])).collect();
+    let pos: Vec<Option<[i64; 2]>> = exact
+        .iter()
+        .map(|p| Some([snap(p[0])?, snap(p[1])?]))
+        .collect();
+    let attr = |v: u32| {
+        let d = &lim[v as usize];
+        [d[2], d[3], d[4], d[5]]
+    };
+    let (xmax, ymax) = (w * SUBPIXEL, h * SUBPIXEL);
+    let face_triangles = |f: usize| -> Vec<Triangle> {
+        let fv = t.face_vertices(f);
+        let mut out = Vec::with_capacity(fv.len() - 2);
+        for i in 1..fv.len() - 1 {
+            let idx = [fv[0], fv[i], fv[i + 1]];
+            let (Some(a), Some(b), Some(c)) = (
+                pos[idx[0] as usize],
+                pos[idx[1] as usize],
+                pos[idx[2] as usize],
+            ) else {
+                continue;
+            };
+            let v = [a, b, c];
+            let outside = v.iter().all(|p| p[0] < 0)
+                || v.iter().all(|p| p[0] > xmax)
+                || v.iter().all(|p| p[1] < 0)
+                || v.iter().all(|p| p[1] > ymax);
+            if outside {
+                continue;
+            }
+            let x = idx.map(|i| exact[i as usize]);
+            if let Some(tri) = Triangle::new(v, x, idx.map(attr)) {
+                if tri.rows.1 > 0 && tri.rows.0 < h && tri.rows.0 < tri.rows.1 {
+                    out.push(tri);
+                }
+            }
+        }
+        out
+    };
+    // Built in parallel, collected in face order.
+    let triangles: Vec<Triangle> = (0..t.face_count())
+        .into_par_iter()
+        .flat_map_iter(face_triangles)
+        .collect();
+    let ranges: Vec<(u32, usize, usize)> = triangles
+        .iter()
+        .enumerate()
+        .map(|(i, tri)| {
+            let a = tri.rows.0.max(0) as usize / BAND;
+            let b = (tri.rows.1.min(h) - 1) as usize / BAND;
+            (i as u32, a, b)
+        })
+        .collect();
+    let triangle_bins = Bins::new(bands, &ranges);
+
+    // The outline, from the control points of level k.
+    let loops = boundary_loops(t);
+    let control_px: Vec<[f64; 2]> = data.levels[k]
+        .iter()
+        .map(|d| xf.apply(d[0], d[1]))
+        .collect();
+    let tolerance = if opts.reference {
+        REFERENCE_OUTLINE_TOLERANCE_PX
+    } else {
+        OUTLINE_TOLERANCE_PX
+    };
+    let all_lines = outline(refinement.level(k), &loops, &control_px, tolerance);
+    let mut lines = Vec::new();
+    let mut line_ranges = Vec::new();
+    let (mut c0, mut c1) = (f64::INFINITY, f64::NEG_INFINITY);
+    for l in all_lines {
+        let (r0, r1) = l.rows();
+        if r1 <= 0 || r0 >= h || r0 == r1 {
+            continue;
+        }
+        // Coverage can be non-zero from the leftmost to the rightmost line crossing the rows,
+        // including lines right of the image, which themselves add nothing visible.
+        c0 = c0.min(l.p0[0]).min(l.p1[0]);
+        c1 = c1.max(l.p0[0]).max(l.p1[0]);
+        if l.p0[0] >= w as f64 && l.p1[0] >= w as f64 {
+            continue;
+        }
+        let a = r0.max(0) as usize / BAND;
+        let b = (r1.min(h) - 1) as usize / BAND;
+        line_ranges.push((lines.len() as u32, a, b));
+        lines.push(l);
+    }
+    let line_bins = Bins::new(bands, &line_ranges);
+    let columns = if lines.is_empty() {
+        (0, 0)
+    } else {
+        (
+            c0.floor().clamp(0.0, w as f64) as usize,
+            (c1.ceil() + 1.0).clamp(0.0, w as f64) as usize,
+        )
+    };
+
+    // Boundary edges of the tessellation, for outline pixels no triangle reaches.
+    let mut segments = Vec::new();
+    for lp in &loops {
+        for i in 0..lp.len() {
+            let (a, b) = (lp[i], lp[(i + 1) % lp.len()]);
+            if pos[a as usize].is_some() && pos[b as usize].is_some() {
+                let c = |v: u32| attr(v).map(|x| x as f32);
+                segments.push(Segment {
+                    a: exact[a as usize],
+                    b: exact[b as usize],
+                    ca: c(a),
+                    cb: c(b),
+                });
+            }
+        }
+    }
+    let nearest = NearestSegments::new(segments);
+
+    let info = LayerInfo {
+        level: k,
+        capped: choice.capped,
+        quads: t.face_count(),
+        triangles: triangles.len(),
+        max_quad_px: choice.measured.map_or(f64::NAN, |m| m.extent),
+        max_outline_deviation_px: choice.measured.map_or(f64::NAN, |m| m.outline),
+        max_colour_error: choice.measured.map_or(f64::NAN, |m| m.colour),
+        estimated: choice.estimated,
+    };
+    if lines.is_empty() || columns.0 >= columns.1 {
+        return Ok((info, None, warnings));
+    }
+    let layer = PreparedLayer {
+        space,
+        triangles,
+        triangle_bins,
+        lines,
+        line_bins,
+        nearest,
+        columns,
+    };
+    Ok((info, Some(layer), warnings))
+}

@@ -1,0 +1,274 @@
+//! The outline of a layer: the limit curves of its boundary, as exact cubic Bézier segments,
+//! flattened into line segments for coverage.
+//!
+//! From level 1 on, boundary edges are infinitely sharp, so the boundary of level `k` is a
+//! uniform cubic B-spline of its boundary vertices, broken at corners (a corner's curve ends
+//! there with the phantom point `2 C - P`, which reproduces the subdivision rules that keep the
+//! corner fixed and put edge points at midpoints). Its limit points are the crease and corner
+//! limit stencils, so the curve runs exactly through the outline of the triangles.
+//!
+//! The two sides of a discontinuous edge are two boundaries over the same control points, run in
+//! opposite directions. Every step here is made independent of the direction of travel (points
+//! snapped first, Bézier points from symmetric sums, each segment flattened in a canonical
+//! direction), so the two sides give the same line segments reversed, which then cancel exactly.
+
+use std::collections::HashMap;
+
+use crate::catmull_clark::Level;
+use crate::rules::VertexRule;
+use crate::topology::Topology;
+
+use super::coverage::Line;
+
+/// Outline points are snapped to 2^-16 pixel, far below anything coverage can show.
+const OUTLINE_GRID: f64 = 65536.0;
+
+fn snap(p: [f64; 2]) -> [f64; 2] {
+    p.map(|v| (v * OUTLINE_GRID).round() / OUTLINE_GRID)
+}
+
+/// The boundary loops of `t`: vertex sequences such that each `v[i] -> v[i + 1]` (cyclically)
+/// is a boundary edge run in the direction of its face. Deterministic order.
+pub(crate) fn boundary_loops(t: &Topology) -> Vec<Vec<u32>> {
+    let mut outgoing: HashMap<u32, u32> = HashMap::new();
+    let mut starts = Vec::new();
+    for e in 0..t.edge_count() {
+        if t.is_boundary_edge(e) {
+            let [a, b] = t.edge_vertices(e);
+            outgoing.insert(a, b);
+            starts.push(a);
+        }
+    }
+    let mut loops = Vec::new();
+    for &s in &starts {
+        if !outgoing.contains_key(&s) {
+            continue;
+        }
+        let mut lp = vec![s];
+        let mut v = outgoing.remove(&s).expect("checked");
+        while v != s {
+            lp.push(v);
+            match outgoing.remove(&v) {
+                Some(n) => v = n,
+                None => break,
+            }
+        }
+        loops.push(lp);
+    }
+    loops
+}
+
+/// One cubic segment of the outline from its four B-spline control points (in pixels, snapped),
+/// flattened to within `tolerance` pixels. Appends the lines to `out`.
+fn flatten_segment(q: [[f64; 2]; 4], tolerance: f64, out: &mut Vec<Line>) {
+    // Flatten in the lexicographically smaller of the two directions.
+    let reversed = [q[3], q[2], q[1], q[0]];
+    let cmp = |a: &[[f64; 2]; 4], b: &[[f64; 2]; 4]| {
+        a.iter()
+            .flatten()
+            .zip(b.iter().flatten())
+            .map(|(x, y)| x.total_cmp(y))
+            .find(|o| o.is_ne())
+            .unwrap_or(std::cmp::Ordering::Equal)
+    };
+    let flip = cmp(&reversed, &q).is_lt();
+    let p = if flip { reversed } else { q };
+    // B-spline to Bézier with sums whose operands commute: the shared end point of neighbouring
+    // segments is bitwise the same in both, and so is the reversed segment's.
+    let b = [0, 1].map(|c| {
+        [
+            ((p[0][c] + p[2][c]) + 4.0 * p[1][c]) / 6.0,
+            (2.0 * p[1][c] + p[2][c]) / 3.0,
+            (p[1][c] + 2.0 * p[2][c]) / 3.0,
+            ((p[1][c] + p[3][c]) + 4.0 * p[2][c]) / 6.0,
+        ]
+    });
+    let pt = |k: usize| snap([b[0][k], b[1][k]]);
+    // Wang's formula: n segments keep the chord within `tolerance` of a cubic.
+    let second = |k: usize| {
+        let dx = b[0][k] - 2.0 * b[0][k + 1] + b[0][k + 2];
+        let dy = b[1][k] - 2.0 * b[1][k + 1] + b[1][k + 2];
+        dx.hypot(dy)
+    };
+    let m = second(0).max(second(1));
+    let n = ((0.75 * m / tolerance).sqrt().ceil() as usize).clamp(1, 4096);
+    let mut pts = Vec::with_capacity(n + 1);
+    pts.push(pt(0));
+    for i in 1..n {
+        let t = i as f64 / n as f64;
+        let mt = 1.0 - t;
+        let w = [mt * mt * mt, 3.0 * mt * mt * t, 3.0 * mt * t * t, t * t * t];
+        let c = |c: usize| w[0] * b[c][0] + w[1] * b[c][1] + w[2] * b[c][2] + w[3] * b[c][3];
+        pts.push(snap([c(0), c(1)]));
+    }
+    pts.push(pt(3));
+    if flip {
+        pts.reverse();
+    }
+    for w in pts.windows(2) {
+        if w[0] != w[1] {
+            out.push(Line { p0: w[0], p1: w[1] });
+        }
+    }
+}
+
+/// The flattened outline of `level`, whose control positions in pixels are `px`.
+pub(crate) fn outline(
+    level: &Level,
+    loops: &[Vec<u32>],
+    px: &[[f64; 2]],
+    tolerance: f64,
+) -> Vec<Line> {
+    let mut lines = Vec::new();
+    for lp in loops {
+        let m = lp.len();
+        if m < 2 {
+            continue;
+        }
+        let pos = |i: usize| snap(px[lp[i % m] as usize]);
+        let corners: Vec<usize> = (0..m)
+            .filter(|&i| level.vertex_rule(lp[i] as usize) == VertexRule::Corner)
+            .collect();
+        if corners.is_empty() {
+            // A closed periodic B-spline.
+            for i in 0..m {
+                let q = [pos(i + m - 1), pos(i), pos(i + 1), pos(i + 2)];
+                flatten_segment(q, tolerance, &mut lines);
+            }
+            continue;
+        }
+        // Open spans from corner to corner, with phantom points at both ends.
+        for (c, &start) in corners.iter().enumerate() {
+            let end = if c + 1 < corners.len() {
+                corners[c + 1]
+            } else {
+                corners[0] + m
+            };
+            let span: Vec<[f64; 2]> = (start..=end).map(pos).collect();
+            let n = span.len() - 1;
+            let phantom = |a: [f64; 2], b: [f64; 2]| [2.0 * a[0] - b[0], 2.0 * a[1] - b[1]];
+            let at = |i: isize| -> [f64; 2] {
+                if i < 0 {
+                    phantom(span[0], span[1])
+                } else if i as usize > n {
+                    phantom(span[n], span[n - 1])
+                } else {
+                    span[i as usize]
+                }
+            };
+            for i in 0..n as isize {
+                flatten_segment(
+                    [at(i - 1), at(i), at(i + 1), at(i + 2)],
+                    tolerance,
+                    &mut lines,
+                );
+            }
+        }
+    }
+    cancel_opposite(lines)
+}
+
+/// Removes pairs of identical segments run in opposite directions (the two sides of a
+/// discontinuous edge), keeping the order of the rest.
+fn cancel_opposite(lines: Vec<Line>) -> Vec<Line> {
+    type Key = ([u64; 2], [u64; 2]);
+    let bits = |p: [f64; 2]| p.map(f64::to_bits);
+    let key = |l: &Line| -> (Key, i32) {
+        let (a, b) = (bits(l.p0), bits(l.p1));
+        if a <= b {
+            ((a, b), 1)
+        } else {
+            ((b, a), -1)
+        }
+    };
+    let mut net: HashMap<Key, i32> = HashMap::with_capacity(lines.len());
+    for l in &lines {
+        let (k, s) = key(l);
+        *net.entry(k).or_insert(0) += s;
+    }
+    if net.len() * 2 == lines.len() && net.values().all(|&v| v == 0) {
+        return Vec::new();
+    }
+    lines
+        .into_iter()
+        .filter(|l| {
+            let (k, s) = key(l);
+            let n = net.get_mut(&k).expect("counted");
+            if *n != 0 && n.signum() == s {
+                *n -= s;
+                true
+            } else {
+                false
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn opposite_segments_cancel() {
+        let l = |a: [f64; 2], b: [f64; 2]| Line { p0: a, p1: b };
+        let lines = vec![
+            l([0.0, 0.0], [1.0, 0.5]),
+            l([1.0, 0.5], [2.0, 2.0]),
+            l([1.0, 0.5], [0.0, 0.0]),
+            l([3.0, 3.0], [4.0, 4.0]),
+            l([3.0, 3.0], [4.0, 4.0]),
+        ];
+        let kept = cancel_opposite(lines);
+        assert_eq!(kept.len(), 3);
+        assert_eq!(kept[0].p0, [1.0, 0.5]);
+        assert_eq!(kept[1], kept[2]);
+    }
+
+    #[test]
+    fn reversed_segment_flattens_to_the_same_points() {
+        let q = [[0.1, 0.3], [2.7, 1.9], [5.2, 1.1], [9.9, 7.3]];
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        flatten_segment(q, 1e-3, &mut a);
+        flatten_segment([q[3], q[2], q[1], q[0]], 1e-3, &mut b);
+        assert!(a.len() > 4);
+        b.reverse();
+        for (x, y) in a.iter().zip(&b) {
+            assert_eq!((x.p0, x.p1), (y.p1, y.p0));
+        }
+    }
+
+    #[test]
+    fn flattening_is_within_tolerance() {
+        let q = [[0.0, 0.0], [3.0, 9.0], [6.0, -4.0], [9.0, 2.0]];
+        let mut lines = Vec::new();
+        let tol = 0.01;
+        flatten_segment(q, tol, &mut lines);
+        let b = [0, 1].map(|c| {
+            [
+                (q[0][c] + 4.0 * q[1][c] + q[2][c]) / 6.0,
+                (2.0 * q[1][c] + q[2][c]) / 3.0,
+                (q[1][c] + 2.0 * q[2][c]) / 3.0,
+                (q[1][c] + 4.0 * q[2][c] + q[3][c]) / 6.0,
+            ]
+        });
+        let curve = |t: f64| {
+            let mt = 1.0 - t;
+            let w = [mt * mt * mt, 3.0 * mt * mt * t, 3.0 * mt * t * t, t * t * t];
+            [0, 1].map(|c| (0..4).map(|k| w[k] * b[c][k]).sum::<f64>())
+        };
+        for i in 0..=1000 {
+            let p = curve(i as f64 / 1000.0);
+            let d = lines
+                .iter()
+                .map(|l| {
+                    let (ax, ay, bx, by) = (l.p0[0], l.p0[1], l.p1[0], l.p1[1]);
+                    let (dx, dy) = (bx - ax, by - ay);
+                    let t = (((p[0] - ax) * dx + (p[1] - ay) * dy) / (dx * dx + dy * dy))
+                        .clamp(0.0, 1.0);
+                    (p[0] - ax - t * dx).hypot(p[1] - ay - t * dy)
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!(d <= tol * 1.01, "{d}");
+        }
+    }
+}

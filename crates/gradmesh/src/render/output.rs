@@ -1,0 +1,226 @@
+//! Output pixels: float, 16-bit and dithered 8-bit RGBA, and PNG files.
+
+use crate::error::{Error, ErrorKind};
+
+/// A channel type the renderer can write: `f32`, `u16` or `u8`.
+///
+/// Buffers hold RGBA with straight (non-premultiplied) alpha and sRGB-encoded colour, four
+/// channels per pixel, rows top to bottom.
+pub trait OutputPixel: Copy + Send + Sync + 'static {
+    /// Whether this type is coarse enough to be dithered (8-bit).
+    const DITHERED: bool;
+
+    /// Encodes a value in `0..=1`. `noise` (in `-1..1`, units of one output step) is added
+    /// before rounding by types that dither; values exactly 0 or 1 are never dithered, so flat
+    /// white, black, opaque and transparent areas stay exact.
+    fn encode(v: f32, noise: f32) -> Self;
+}
+
+impl OutputPixel for f32 {
+    const DITHERED: bool = false;
+    fn encode(v: f32, _noise: f32) -> Self {
+        v
+    }
+}
+
+impl OutputPixel for u16 {
+    const DITHERED: bool = false;
+    fn encode(v: f32, _noise: f32) -> Self {
+        (v.clamp(0.0, 1.0) * 65535.0 + 0.5) as u16
+    }
+}
+
+impl OutputPixel for u8 {
+    const DITHERED: bool = true;
+    fn encode(v: f32, noise: f32) -> Self {
+        if v <= 0.0 {
+            0
+        } else if v >= 1.0 {
+            255
+        } else {
+            (v * 255.0 + 0.5 + noise).floor().clamp(0.0, 255.0) as u8
+        }
+    }
+}
+
+/// Deterministic triangular (TPDF) dither noise in `-1..1` for channel `c` of pixel `(x, y)`:
+/// the sum of two uniform hashes, so quantisation error is independent of the signal and
+/// smooth gradients show no bands. No pattern repeats at a small period, unlike a Bayer matrix.
+pub(crate) fn dither_noise(x: u32, y: u32, c: u32) -> f32 {
+    let h = |seed: u32| -> f32 {
+        let mut v = x
+            .wrapping_mul(0x9E37_79B1)
+            .wrapping_add(y.wrapping_mul(0x85EB_CA77))
+            .wrapping_add(c.wrapping_mul(0xC2B2_AE3D))
+            .wrapping_add(seed);
+        // A 32-bit finaliser (lowbias32).
+        v ^= v >> 16;
+        v = v.wrapping_mul(0x7FEB_352D);
+        v ^= v >> 15;
+        v = v.wrapping_mul(0x846C_A68B);
+        v ^= v >> 16;
+        (v >> 8) as f32 / (1u32 << 24) as f32
+    };
+    h(0x68E3_1DA4) + h(0xB529_7A4D) - 1.0
+}
+
+/// An RGBA image with `f32` channels: straight (non-premultiplied) alpha, sRGB-encoded colour
+/// in `0..=1`, rows top to bottom.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `4 * width * height` channels.
+    pub data: Vec<f32>,
+}
+
+impl Image {
+    /// A transparent image.
+    pub fn new(width: u32, height: u32) -> Self {
+        Image {
+            width,
+            height,
+            data: vec![0.0; 4 * width as usize * height as usize],
+        }
+    }
+
+    /// The RGBA channels of pixel `(x, y)`.
+    pub fn pixel(&self, x: u32, y: u32) -> [f32; 4] {
+        let i = 4 * (y as usize * self.width as usize + x as usize);
+        [
+            self.data[i],
+            self.data[i + 1],
+            self.data[i + 2],
+            self.data[i + 3],
+        ]
+    }
+
+    /// The channels quantised to 8 bits (with optional dithering).
+    pub fn to_u8(&self, dither: bool) -> Vec<u8> {
+        self.quantise(dither)
+    }
+
+    /// The channels quantised to 16 bits.
+    pub fn to_u16(&self) -> Vec<u16> {
+        self.quantise(false)
+    }
+
+    fn quantise<P: OutputPixel>(&self, dither: bool) -> Vec<P> {
+        let w = self.width as usize;
+        self.data
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| {
+                let noise = if dither && P::DITHERED {
+                    let p = i / 4;
+                    dither_noise((p % w) as u32, (p / w) as u32, (i % 4) as u32)
+                } else {
+                    0.0
+                };
+                P::encode(v, noise)
+            })
+            .collect()
+    }
+}
+
+/// Encodes an image as an RGBA PNG of 8 or 16 bits per channel, marked as sRGB (an `sRGB` chunk,
+/// perceptual intent, with the fallback `gAMA` and `cHRM` the PNG specification recommends).
+/// `dither` applies to 8-bit output only.
+pub fn encode_png(image: &Image, bits: u8, dither: bool) -> Result<Vec<u8>, Error> {
+    let depth = match bits {
+        8 => png::BitDepth::Eight,
+        16 => png::BitDepth::Sixteen,
+        _ => {
+            return Err(ErrorKind::Invalid {
+                what: "PNG bit depth".into(),
+                message: format!("must be 8 or 16, not {bits}"),
+            }
+            .into())
+        }
+    };
+    let bytes: Vec<u8> = if bits == 8 {
+        image.to_u8(dither)
+    } else {
+        image
+            .to_u16()
+            .iter()
+            .flat_map(|v| v.to_be_bytes())
+            .collect()
+    };
+    let io = |e: png::EncodingError| Error::from(ErrorKind::Io(format!("PNG encoding: {e}")));
+    let mut out = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut out, image.width, image.height);
+        enc.set_color(png::ColorType::Rgba);
+        enc.set_depth(depth);
+        enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        let mut writer = enc.write_header().map_err(io)?;
+        writer.write_image_data(&bytes).map_err(io)?;
+        writer.finish().map_err(io)?;
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn noise_is_triangular_and_centred() {
+        let mut sum = 0.0;
+        let mut inner = 0;
+        let n = 200_000;
+        for i in 0..n {
+            let v = dither_noise(i % 512, i / 512, 1);
+            assert!((-1.0..1.0).contains(&v));
+            sum += v as f64;
+            if v.abs() < 0.5 {
+                inner += 1;
+            }
+        }
+        assert!((sum / n as f64).abs() < 0.01);
+        // A triangular density puts 3/4 of its mass within half the range.
+        assert!((inner as f64 / n as f64 - 0.75).abs() < 0.01);
+    }
+
+    #[test]
+    fn dithering_keeps_the_mean_and_the_extremes() {
+        let mut img = Image::new(64, 64);
+        img.data
+            .iter_mut()
+            .for_each(|v| *v = 0.3 / 255.0 + 100.0 / 255.0);
+        img.data[0] = 0.0;
+        img.data[1] = 1.0;
+        let q = img.to_u8(true);
+        assert_eq!((q[0], q[1]), (0, 255));
+        let mean = q[2..].iter().map(|&v| v as f64).sum::<f64>() / (q.len() - 2) as f64;
+        assert!((mean - 100.3).abs() < 0.05, "{mean}");
+        assert!(img.to_u8(false)[2..].iter().all(|&v| v == 100));
+    }
+
+    #[test]
+    fn png_has_an_srgb_chunk_and_round_trips() {
+        let mut img = Image::new(3, 2);
+        for (i, v) in img.data.iter_mut().enumerate() {
+            *v = i as f32 / 23.0;
+        }
+        for bits in [8, 16] {
+            let bytes = encode_png(&img, bits, false).unwrap();
+            let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+            let mut reader = decoder.read_info().unwrap();
+            assert!(reader.info().srgb.is_some());
+            let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+            let frame = reader.next_frame(&mut buf).unwrap();
+            assert_eq!((frame.width, frame.height), (3, 2));
+            if bits == 16 {
+                let v = u16::from_be_bytes([buf[2 * 5], buf[2 * 5 + 1]]);
+                assert_eq!(v, (5.0 / 23.0 * 65535.0f32 + 0.5) as u16);
+            } else {
+                assert_eq!(buf[5], (5.0 / 23.0 * 255.0f32 + 0.5) as u8);
+            }
+        }
+        assert!(encode_png(&img, 4, false).is_err());
+    }
+}
