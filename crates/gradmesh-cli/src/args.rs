@@ -28,6 +28,35 @@ pub enum Command {
 }
 
 /// Limits on the input (`gradmesh::Limits`), raised for trusted input.
+/// The paper's options (section 4.5), applied to every layer; without them each layer keeps
+/// what its file says.
+#[derive(Debug, Args)]
+#[command(next_help_heading = "Scheme options")]
+pub struct VariantArgs {
+    /// Make the limit surface pass through the control points.
+    #[arg(long)]
+    pub interpolate_positions: bool,
+    /// The first refinement: ternary (the paper's) or binary (two binary splits).
+    #[arg(long, value_name = "STEP", value_parser = ["ternary", "binary"])]
+    pub first_step: Option<String>,
+}
+
+impl VariantArgs {
+    /// Applies the options to every layer of `doc`.
+    pub fn apply(&self, doc: &mut gradmesh::Document) {
+        for mesh in &mut doc.layers {
+            if self.interpolate_positions {
+                mesh.interpolate_positions = true;
+            }
+            match self.first_step.as_deref() {
+                Some("binary") => mesh.first_step = gradmesh::FirstStep::Binary,
+                Some("ternary") => mesh.first_step = gradmesh::FirstStep::Ternary,
+                _ => {}
+            }
+        }
+    }
+}
+
 #[derive(Debug, Args)]
 #[command(next_help_heading = "Limits")]
 pub struct LimitArgs {
@@ -81,6 +110,9 @@ pub struct ConvertArgs {
     /// Allow the output to be the input file itself.
     #[arg(long)]
     pub force: bool,
+    /// The paper's options.
+    #[command(flatten)]
+    pub variant: VariantArgs,
     /// Limits.
     #[command(flatten)]
     pub limits: LimitArgs,
@@ -103,6 +135,9 @@ pub struct RefineArgs {
     /// Allow the output to be the input file itself.
     #[arg(long)]
     pub force: bool,
+    /// The paper's options.
+    #[command(flatten)]
+    pub variant: VariantArgs,
     /// Deepest refinement level accepted [default: 12].
     #[arg(long, value_name = "LEVEL", help_heading = "Limits")]
     pub max_level: Option<usize>,
@@ -163,6 +198,9 @@ pub struct RenderArgs {
     /// Allow the output to be one of the input files.
     #[arg(long)]
     pub force: bool,
+    /// The paper's options.
+    #[command(flatten)]
+    pub variant: VariantArgs,
     /// Limits.
     #[command(flatten)]
     pub limits: LimitArgs,

@@ -279,3 +279,77 @@ fn output_into_a_missing_directory_is_a_clear_error() {
     let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
     assert_eq!(names.len(), 1, "a temporary file was left behind");
 }
+
+#[test]
+fn scheme_options_on_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = realdata().join("Tucan_Tucan_Layer3.off");
+    // Interpolated positions: every control point is a limit point.
+    let out = dir.path().join("limit.obj");
+    let o = gradmesh(&[
+        "refine",
+        s(&input),
+        "-o",
+        s(&out),
+        "--levels",
+        "2",
+        "--limit",
+        "--interpolate-positions",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let limits: Vec<(f64, f64)> = text
+        .lines()
+        .filter(|l| l.starts_with("v "))
+        .map(|l| {
+            let f: Vec<f64> = l[2..]
+                .split_whitespace()
+                .map(|x| x.parse().unwrap())
+                .collect();
+            (f[0], f[1])
+        })
+        .collect();
+    let original = std::fs::read_to_string(&input).unwrap();
+    let count: usize = original
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split_whitespace()
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    for line in original.lines().skip(2).take(count) {
+        let f: Vec<f64> = line
+            .split_whitespace()
+            .take(2)
+            .map(|x| x.parse().unwrap())
+            .collect();
+        assert!(
+            limits
+                .iter()
+                .any(|&(x, y)| (x - f[0]).abs() < 1e-6 && (y - f[1]).abs() < 1e-6),
+            "control point ({}, {}) is not a limit point",
+            f[0],
+            f[1]
+        );
+    }
+    // Two binary steps: level 1 is all quads.
+    let out = dir.path().join("binary.obj");
+    let o = gradmesh(&[
+        "refine",
+        s(&input),
+        "-o",
+        s(&out),
+        "--levels",
+        "1",
+        "--first-step",
+        "binary",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text
+        .lines()
+        .filter(|l| l.starts_with("f "))
+        .all(|l| l.split_whitespace().count() == 5));
+}

@@ -23,7 +23,8 @@ pub fn run(args: &RefineArgs) -> Result<(), Error> {
     if let Some(faces) = args.max_refined_faces {
         limits.refined_faces = faces;
     }
-    let doc = super::read(&args.input, &limits)?;
+    let mut doc = super::read(&args.input, &limits)?;
+    args.variant.apply(&mut doc);
     let mut layers = Vec::with_capacity(doc.layers.len());
     for (i, mesh) in doc.layers.iter().enumerate() {
         let locate = |e: Error| e.in_layer(i).in_file(&args.input);

@@ -86,6 +86,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     for path in &args.inputs {
         doc.layers.extend(super::read(path, &limits)?.layers);
     }
+    args.variant.apply(&mut doc);
     let read = start.elapsed();
 
     let opts = options(args, &doc)?;
