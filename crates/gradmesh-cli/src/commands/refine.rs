@@ -37,15 +37,16 @@ pub fn run(args: &RefineArgs) -> Result<(), Error> {
                 .map_err(locate)?;
         }
         super::print_warnings(&args.input, &warnings);
-        let data = refinement.evaluate();
+        let mut data = refinement.evaluate();
         let points = if args.limit {
             refinement.limit(&data, args.levels)
         } else {
-            data.levels[args.levels].clone()
+            std::mem::take(&mut data.levels[args.levels])
         };
+        drop(data);
         layers.push((refinement, points));
     }
-    let text = match format {
+    match format {
         Format::Obj => {
             let parts: Vec<_> = doc
                 .layers
@@ -59,7 +60,9 @@ pub fn run(args: &RefineArgs) -> Result<(), Error> {
                     )
                 })
                 .collect();
-            formats::obj::write_refined_obj(&parts)
+            formats::write_atomic_with(&args.output, |w| {
+                formats::obj::write_refined_obj_to(w, &parts)
+            })
         }
         _ => {
             let parts: Vec<_> = doc
@@ -73,8 +76,10 @@ pub fn run(args: &RefineArgs) -> Result<(), Error> {
                     data: points,
                 })
                 .collect();
-            formats::json::write_refined(&parts)
+            formats::write_atomic(
+                &args.output,
+                formats::json::write_refined(&parts).as_bytes(),
+            )
         }
-    };
-    formats::write_atomic(&args.output, text.as_bytes())
+    }
 }

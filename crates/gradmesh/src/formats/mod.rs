@@ -196,6 +196,15 @@ static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 ///
 /// An existing file's permissions are kept. The error is located in `path`.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
+    write_atomic_with(path, |w| w.write_all(bytes))
+}
+
+/// As [`write_atomic`], for output produced piece by piece: `write` streams into the
+/// temporary file (buffered), so a large output is never held in memory whole.
+pub fn write_atomic_with(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), Error> {
     let fail = |what: &str, e: std::io::Error| {
         Error::new(ErrorKind::Io(format!("cannot {what}: {e}"))).in_file(path)
     };
@@ -254,7 +263,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
         }
     };
     let result = (|| {
-        file.write_all(bytes).map_err(|e| fail("write", e))?;
+        let mut buffered = std::io::BufWriter::with_capacity(1 << 16, &mut file);
+        write(&mut buffered).map_err(|e| fail("write", e))?;
+        buffered.flush().map_err(|e| fail("write", e))?;
+        drop(buffered);
         if let Some(p) = permissions {
             file.set_permissions(p)
                 .map_err(|e| fail("set permissions", e))?;
