@@ -353,3 +353,18 @@ fn scheme_options_on_the_command_line() {
         .filter(|l| l.starts_with("f "))
         .all(|l| l.split_whitespace().count() == 5));
 }
+
+#[test]
+fn info_warns_where_the_surface_folds() {
+    let examples = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples"));
+    let o = gradmesh(&["info", s(&examples.join("fold.json"))]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8(o.stdout).unwrap();
+    assert!(
+        text.contains("the surface folds over itself near"),
+        "{text}"
+    );
+    let o = gradmesh(&["info", s(&examples.join("fold-fixed.json"))]);
+    let text = String::from_utf8(o.stdout).unwrap();
+    assert!(!text.contains("folds over itself"), "{text}");
+}

@@ -57,7 +57,17 @@ fn histogram(values: impl Iterator<Item = usize>) -> String {
 }
 
 fn describe(mesh: &GradientMesh) -> Result<(String, Vec<gradmesh::Warning>), Error> {
-    let (base, warnings) = BaseMesh::new(mesh)?;
+    let (base, mut warnings) = BaseMesh::new(mesh)?;
+    for fold in gradmesh::render::find_folds(mesh)? {
+        warnings.push(gradmesh::Warning {
+            layer: None,
+            message: format!(
+                "the surface folds over itself near ({:.1}, {:.1}), in faces {:?} (area {:.3}): \
+                 make the mesh more convex there or shorten its handles",
+                fold.position.x, fold.position.y, fold.faces, fold.area
+            ),
+        });
+    }
     let whole = Topology::from_faces(mesh.points.len(), &mesh.faces)?;
     let mut s = String::new();
     if let Some(name) = &mesh.name {
