@@ -169,18 +169,86 @@ impl Stencils {
     }
 
     /// Applies the stencils to parent data, writing into `out` (one entry per stencil).
+    ///
+    /// Large tables are applied in parallel; every stencil is summed in the same order whatever
+    /// the thread count, so the result does not depend on it.
     pub fn apply_into(&self, parent: &[VertexData], out: &mut [VertexData]) {
-        for (i, o) in out.iter_mut().enumerate() {
-            let (src, w) = self.stencil(i);
-            let mut acc = [0.0; 6];
-            for (&s, &w) in src.iter().zip(w) {
-                let p = &parent[s as usize];
-                for c in 0..6 {
-                    acc[c] += w * p[c];
+        use rayon::prelude::*;
+        const CHUNK: usize = 1 << 12;
+        let apply = |first: usize, chunk: &mut [VertexData]| {
+            for (i, o) in chunk.iter_mut().enumerate() {
+                let (src, w) = self.stencil(first + i);
+                let mut acc = [0.0; 6];
+                for (&s, &w) in src.iter().zip(w) {
+                    let p = &parent[s as usize];
+                    for c in 0..6 {
+                        acc[c] += w * p[c];
+                    }
                 }
+                *o = acc;
             }
-            *o = acc;
+        };
+        if out.len() <= CHUNK {
+            apply(0, out);
+        } else {
+            out.par_chunks_mut(CHUNK)
+                .enumerate()
+                .for_each(|(k, chunk)| apply(k * CHUNK, chunk));
         }
+    }
+
+    /// The table of stencils `0..n`, stencil `i` made of the terms `terms(i, buffer)` pushes
+    /// into an empty buffer. Built in parallel by ranges and concatenated in order: the same
+    /// table whatever the thread count.
+    pub fn build(n: usize, terms: impl Fn(usize, &mut Vec<(u32, f64)>) + Sync) -> Stencils {
+        use rayon::prelude::*;
+        const CHUNK: usize = 1 << 14;
+        let range = |r: std::ops::Range<usize>| {
+            let mut stencils = Stencils::with_capacity(r.len(), 10 * r.len());
+            let mut buffer = Vec::with_capacity(64);
+            for i in r {
+                terms(i, &mut buffer);
+                stencils.push(&mut buffer);
+            }
+            stencils
+        };
+        if n <= CHUNK {
+            return range(0..n);
+        }
+        let parts: Vec<Stencils> = (0..n.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|k| range(k * CHUNK..((k + 1) * CHUNK).min(n)))
+            .collect();
+        Stencils::concat(&parts)
+    }
+
+    /// An empty table with room for `n` stencils of `terms` terms in all.
+    pub fn with_capacity(n: usize, terms: usize) -> Self {
+        let mut stencils = Stencils::new();
+        stencils.offsets.reserve(n);
+        stencils.sources.reserve(terms);
+        stencils.weights.reserve(terms);
+        stencils
+    }
+
+    /// The tables `parts` one after the other.
+    pub fn concat(parts: &[Stencils]) -> Stencils {
+        let n: usize = parts.iter().map(|p| p.len()).sum();
+        let terms: usize = parts.iter().map(|p| p.sources.len()).sum();
+        let mut stencils = Stencils::with_capacity(n, terms);
+        for part in parts {
+            stencils.append(part);
+        }
+        stencils
+    }
+
+    /// Appends the stencils of `other` after these.
+    pub fn append(&mut self, other: &Stencils) {
+        let base = *self.offsets.last().expect("offsets start with 0");
+        self.offsets
+            .extend(other.offsets[1..].iter().map(|&o| o + base));
+        self.sources.extend_from_slice(&other.sources);
+        self.weights.extend_from_slice(&other.weights);
     }
 }
 
@@ -279,14 +347,11 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
         creasing: parent.creasing,
     };
 
-    // Stencils.
-    let mut stencils = Stencils::new();
-    let mut terms = Vec::with_capacity(64);
-    for f in 0..nf {
-        face_centroid_terms(t, f, 1.0, &mut terms);
-        stencils.push(&mut terms);
-    }
-    for e in 0..ne {
+    // Stencils: face points, edge points, vertex points, each built in parallel by ranges.
+    let face_stencil = |f: usize, terms: &mut Vec<(u32, f64)>| {
+        face_centroid_terms(t, f, 1.0, terms);
+    };
+    let edge_stencil = |e: usize, terms: &mut Vec<(u32, f64)>| {
         let [a, b] = t.edge_vertices(e);
         let s = parent.edge_sharpness[e];
         let [f0, f1] = t.edge_faces(e);
@@ -302,19 +367,18 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
             let smooth = 1.0 - crease;
             terms.push((a, 0.25 * smooth));
             terms.push((b, 0.25 * smooth));
-            face_centroid_terms(t, f0 as usize, 0.25 * smooth, &mut terms);
-            face_centroid_terms(t, f1 as usize, 0.25 * smooth, &mut terms);
+            face_centroid_terms(t, f0 as usize, 0.25 * smooth, terms);
+            face_centroid_terms(t, f1 as usize, 0.25 * smooth, terms);
         }
-        stencils.push(&mut terms);
-    }
-    for v in 0..nv {
+    };
+    let vertex_stencil = |v: usize, terms: &mut Vec<(u32, f64)>| {
         let cv = vertex_point(v as u32) as usize;
         let parent_rule = parent.vertex_rule(v);
         let child_rule = child.vertex_rule(cv);
         let parent_sharp =
             |k: usize| rules::is_sharp(parent.edge_sharpness[t.vertex_edges(v)[k] as usize]);
         if parent_rule == child_rule || parent_rule <= VertexRule::Dart {
-            vertex_mask_terms(parent, v, parent_rule, parent_sharp, 1.0, &mut terms);
+            vertex_mask_terms(parent, v, parent_rule, parent_sharp, 1.0, terms);
         } else {
             // The rule relaxes at this level: blend the two masks (Pixar's semi-sharp rule).
             // Child ring edge k is the half of parent ring edge k at this vertex.
@@ -330,11 +394,19 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
                 &parent.incident_sharpness(v),
                 &child_incident,
             );
-            vertex_mask_terms(parent, v, parent_rule, parent_sharp, w, &mut terms);
-            vertex_mask_terms(parent, v, child_rule, child_sharp, 1.0 - w, &mut terms);
+            vertex_mask_terms(parent, v, parent_rule, parent_sharp, w, terms);
+            vertex_mask_terms(parent, v, child_rule, child_sharp, 1.0 - w, terms);
         }
-        stencils.push(&mut terms);
-    }
+    };
+    let stencils = Stencils::build(nf + ne + nv, |i, terms| {
+        if i < nf {
+            face_stencil(i, terms)
+        } else if i < nf + ne {
+            edge_stencil(i - nf, terms)
+        } else {
+            vertex_stencil(i - nf - ne, terms)
+        }
+    });
     (child, stencils)
 }
 

@@ -18,11 +18,28 @@ use crate::rules::{self, VertexRule};
 /// The limit stencils of every vertex of `level`, or `None` if a face adjacent to a smooth
 /// vertex is not a quad (refine once more first).
 pub fn limit_stencils(level: &Level) -> Option<Stencils> {
+    use rayon::prelude::*;
+    // Built in parallel by ranges of vertices, concatenated in order: the same table whatever
+    // the thread count.
+    const CHUNK: usize = 1 << 14;
+    let n = level.topology.vertex_count();
+    if n <= CHUNK {
+        return limit_stencils_of(level, 0..n);
+    }
+    let parts: Vec<Stencils> = (0..n.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|k| limit_stencils_of(level, k * CHUNK..((k + 1) * CHUNK).min(n)))
+        .collect::<Option<_>>()?;
+    Some(Stencils::concat(&parts))
+}
+
+/// The limit stencils of vertices `range` of `level` (see [`limit_stencils`]).
+fn limit_stencils_of(level: &Level, range: std::ops::Range<usize>) -> Option<Stencils> {
     let t = &level.topology;
-    let mut stencils = Stencils::new();
+    let mut stencils = Stencils::with_capacity(range.len(), 10 * range.len());
     let mut terms = Vec::with_capacity(32);
     let mut dart_masks: HashMap<usize, Vec<f64>> = HashMap::new();
-    for v in 0..t.vertex_count() {
+    for v in range {
         let edges = t.vertex_edges(v);
         match level.vertex_rule(v) {
             VertexRule::Corner => terms.push((v as u32, 1.0)),

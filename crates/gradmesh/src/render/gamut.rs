@@ -89,11 +89,107 @@ pub(crate) fn to_blend_space(
     gamut: GamutMapping,
     blend: BlendSpace,
 ) -> [f64; 3] {
-    let lin = gamut.apply(space.to_linear_srgb(c));
+    // sRGB-encoded colours in range blended in sRGB: decoding, the (identity) gamut mapping and
+    // encoding again give the colour back.
+    if space == ColourSpace::Srgb
+        && blend == BlendSpace::Srgb
+        && c.iter().all(|v| (0.0..=1.0).contains(v))
+    {
+        return c;
+    }
+    let lin = match space {
+        ColourSpace::Lab => lab_to_linear_srgb(c),
+        _ => space.to_linear_srgb(c),
+    };
+    let lin = gamut.apply(lin);
     match blend {
         BlendSpace::Linear => lin,
-        BlendSpace::Srgb => lin.map(srgb_encode),
+        BlendSpace::Srgb => lin.map(srgb_encode_fast),
     }
+}
+
+/// CIE Lab (D65) to linear-light sRGB, specialised: the inverse of the Lab function, then the
+/// linear map from the reference white's XYZ to linear sRGB. The map's matrix and the white are
+/// taken from `palette` (the converter of [`ColourSpace::to_linear_srgb`]), so the two agree to
+/// rounding.
+pub(crate) fn lab_to_linear_srgb(c: [f64; 3]) -> [f64; 3] {
+    // Linear sRGB from the factors (X / Xn, Y, Z / Zn).
+    static MATRIX: std::sync::OnceLock<[[f64; 3]; 3]> = std::sync::OnceLock::new();
+    let m = MATRIX.get_or_init(|| {
+        // The map from the three factors (X / Xn, Y, Z / Zn) to linear sRGB is linear: probe
+        // it with Lab colours whose factors lie in the linear part of the inverse Lab function.
+        let probe = |f: [f64; 3]| -> [f64; 3] {
+            let t = |f: f64| f / (3.0 * (6.0f64 / 29.0).powi(2)) + 4.0 / 29.0;
+            let (tx, ty, tz) = (t(f[0]), t(f[1]), t(f[2]));
+            let (l, a, b) = (116.0 * ty - 16.0, 500.0 * (tx - ty), 200.0 * (ty - tz));
+            ColourSpace::Lab.to_linear_srgb([l, a, b])
+        };
+        let eps = 1e-3;
+        let cols = [
+            probe([eps, 0.0, 0.0]),
+            probe([0.0, eps, 0.0]),
+            probe([0.0, 0.0, eps]),
+        ];
+        let mut m = [[0.0; 3]; 3];
+        for (j, col) in cols.iter().enumerate() {
+            for i in 0..3 {
+                m[i][j] = col[i] / eps;
+            }
+        }
+        m
+    });
+    let fy = (c[0] + 16.0) / 116.0;
+    let fx = fy + c[1] / 500.0;
+    let fz = fy - c[2] / 200.0;
+    let finv = |t: f64| {
+        if t > 6.0 / 29.0 {
+            t * t * t
+        } else {
+            3.0 * (6.0f64 / 29.0).powi(2) * (t - 4.0 / 29.0)
+        }
+    };
+    let (x, y, z) = (finv(fx), finv(fy), finv(fz));
+    [0, 1, 2].map(|i| m[i][0] * x + m[i][1] * y + m[i][2] * z)
+}
+
+/// Octaves of the encoding table: linear values from `2^-ENCODE_OCTAVES` to 1.
+const ENCODE_OCTAVES: u32 = 9;
+/// Table entries per octave (a power of two).
+const ENCODE_STEPS: u32 = 1 << 10;
+
+/// [`srgb_encode`] at the start of every step of the table's octaves, and 1 at the end.
+fn encode_table() -> &'static [f64] {
+    static TABLE: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        let n = ENCODE_OCTAVES * ENCODE_STEPS;
+        (0..=n)
+            .map(|i| {
+                let octave = (i / ENCODE_STEPS) as i32 - ENCODE_OCTAVES as i32;
+                let m = 1.0 + (i % ENCODE_STEPS) as f64 / ENCODE_STEPS as f64;
+                srgb_encode(m * 2f64.powi(octave))
+            })
+            .collect()
+    })
+}
+
+/// [`srgb_encode`] by a table with linear interpolation within each of 1024 steps per octave
+/// (relative error under 1e-7, far below a 16-bit step) for values in `[2^-9, 1)`; exact
+/// elsewhere (the linear segment, which ends at 0.0031308 > 2^-9, and out-of-range values).
+pub(crate) fn srgb_encode_fast(linear: f64) -> f64 {
+    let lo = 1.0 / (1u32 << ENCODE_OCTAVES) as f64;
+    if !(lo..1.0).contains(&linear) || linear <= 0.003_130_8 {
+        return srgb_encode(linear);
+    }
+    // Within octave [2^e, 2^(e+1)) the value is linear in the mantissa.
+    let bits = linear.to_bits();
+    let exponent = ((bits >> 52) & 0x7ff) as i64 - 1023;
+    let mantissa = bits & ((1u64 << 52) - 1);
+    let shift = 52 - ENCODE_STEPS.trailing_zeros();
+    let step = (mantissa >> shift) as usize;
+    let frac = (mantissa & ((1u64 << shift) - 1)) as f64 / (1u64 << shift) as f64;
+    let i = (exponent + ENCODE_OCTAVES as i64) as usize * ENCODE_STEPS as usize + step;
+    let t = encode_table();
+    t[i] + frac * (t[i + 1] - t[i])
 }
 
 fn in_gamut(rgb: [f64; 3], tolerance: f64) -> bool {
@@ -192,6 +288,40 @@ fn reduce_chroma(rgb: [f64; 3]) -> [f64; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lab_conversion_matches_palette() {
+        let mut worst = 0.0f64;
+        for l in (0..=20).map(|k| k as f64 * 5.0) {
+            for a in (-8..=8).map(|k| k as f64 * 15.0) {
+                for b in (-8..=8).map(|k| k as f64 * 15.0) {
+                    let (x, y) = (
+                        lab_to_linear_srgb([l, a, b]),
+                        ColourSpace::Lab.to_linear_srgb([l, a, b]),
+                    );
+                    for k in 0..3 {
+                        worst = worst.max((x[k] - y[k]).abs() / y[k].abs().max(1.0));
+                    }
+                }
+            }
+        }
+        assert!(worst < 1e-9, "worst {worst}");
+    }
+
+    #[test]
+    fn fast_encoding_matches_the_transfer_function() {
+        let mut worst = 0.0f64;
+        let n = 200_000;
+        for k in 0..=n {
+            // Dense in [0, 1], with a few values beyond.
+            let x = (k as f64 / n as f64).powi(3) * 1.01 - 0.001;
+            worst = worst.max((srgb_encode_fast(x) - srgb_encode(x)).abs());
+        }
+        assert!(worst < 1e-7, "worst {worst}");
+        for x in [0.0, 1.0, 0.003_130_8, 1.0 / 512.0, 0.5, 0.25] {
+            assert!((srgb_encode_fast(x) - srgb_encode(x)).abs() < 1e-12, "{x}");
+        }
+    }
 
     #[test]
     fn oklab_round_trip_and_white() {

@@ -440,7 +440,15 @@ pub(crate) fn prepare(
                 || v.iter().all(|p| p[0] > xmax)
                 || v.iter().all(|p| p[1] < 0)
                 || v.iter().all(|p| p[1] > ymax);
-            if outside {
+            // No pixel centre column between the leftmost and rightmost vertex: nothing to draw
+            // (at deep levels most quads are under a pixel).
+            let half = SUBPIXEL / 2;
+            let left = v.iter().map(|p| p[0]).min().expect("three vertices");
+            let right = v.iter().map(|p| p[0]).max().expect("three vertices");
+            let no_column = (left - half).div_euclid(SUBPIXEL)
+                == (right - half).div_euclid(SUBPIXEL)
+                && (left - half).rem_euclid(SUBPIXEL) != 0;
+            if outside || no_column {
                 continue;
             }
             let x = idx.map(|i| exact[i as usize]);

@@ -69,7 +69,7 @@ mod view;
 
 use rayon::prelude::*;
 
-use crate::colour::{srgb_decode, srgb_encode, ColourSpace};
+use crate::colour::{srgb_decode, ColourSpace};
 use crate::error::{Error, ErrorKind, Warning};
 use crate::mesh::{Document, GradientMesh};
 
@@ -470,7 +470,7 @@ fn draw_band<P: OutputPixel>(
                 let v = (c[ch] / c[3]).clamp(0.0, 1.0);
                 rgba[ch] = match opts.blend {
                     BlendSpace::Srgb => v,
-                    BlendSpace::Linear => srgb_encode(v),
+                    BlendSpace::Linear => gamut::srgb_encode_fast(v),
                 };
             }
             rgba[3] = a;
