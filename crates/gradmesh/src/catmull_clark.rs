@@ -280,6 +280,10 @@ fn vertex_mask_terms(
                 }
             }
         }
+        // A point no face uses has no ring: it stays where it is.
+        VertexRule::Smooth | VertexRule::Dart if t.vertex_edges(v).is_empty() => {
+            terms.push((v as u32, scale))
+        }
         VertexRule::Smooth | VertexRule::Dart => {
             let edges = t.vertex_edges(v);
             let n = edges.len() as f64;

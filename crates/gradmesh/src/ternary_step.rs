@@ -291,8 +291,10 @@ pub fn ternary_topology(t: &Topology) -> Topology {
 /// `D1` is the handle along the edge to the next corner `V1`, `D2` along the edge to the
 /// previous corner `V2`, and `C` the centroid of the face.
 pub fn face_point_position(v0: Point, v1: Point, v2: Point, d1: Vec2, d2: Vec2, c: Point) -> Point {
-    let w1 = 2.0 * d1.hypot() / (v1 - v0).hypot();
-    let w2 = 2.0 * d2.hypot() / (v2 - v0).hypot();
+    // f64::hypot, not Vec2::hypot: no overflow or underflow at extreme scales.
+    let length = |v: Vec2| v.x.hypot(v.y);
+    let w1 = 2.0 * length(d1) / length(v1 - v0);
+    let w2 = 2.0 * length(d2) / length(v2 - v0);
     v0 + d1 * (1.0 - w2) + d2 * (1.0 - w1) + (c - v0) * (w1 * w2)
 }
 

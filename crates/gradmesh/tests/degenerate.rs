@@ -278,11 +278,8 @@ fn a_mesh_outside_the_view_renders_transparent() {
     assert!(image.data.iter().all(|x| x.is_finite()));
 }
 
-/// A view that lies inside one face shows the face everywhere. Reported to the renderer's
-/// author: the image comes out fully transparent (while the same spot is covered in a view of
-/// the whole mesh).
+/// A view that lies inside one face shows the face everywhere.
 #[test]
-#[ignore = "renderer bug: a view inside a face renders transparent"]
 fn a_view_inside_a_face_is_covered() {
     let doc = Document {
         layers: vec![sample()],
@@ -304,7 +301,6 @@ fn a_view_inside_a_face_is_covered() {
 /// Catmull-Clark vertex rule divides by its valence, 0. Reported as a core bug; the fuzz
 /// entry points skip such vertices until it is fixed.
 #[test]
-#[ignore = "core bug: an isolated point becomes NaN from level 2 (catmull_clark vertex rule)"]
 fn isolated_points_stay_finite() {
     let mut mesh = sample();
     mesh.add_point(Point::new(5.0, 5.0), [50.0, 0.0, 0.0]);
