@@ -232,6 +232,17 @@ impl BaseMesh {
                 ]
             })
             .collect();
+        // The split vertex of each (point, face) corner, to find wedge entries in constant time.
+        let mut wedge_at: HashMap<(u32, u32), u32> = HashMap::new();
+        if !mesh.wedges.is_empty() {
+            wedge_at.reserve(corner_vertex.len());
+            for (f, face) in mesh.faces.iter().enumerate() {
+                let o = whole.face_offset(f);
+                for (c, &p) in face.iter().enumerate() {
+                    wedge_at.insert((p, f as u32), corner_vertex[o + c]);
+                }
+            }
+        }
         let mut override_handles: Vec<Option<&BTreeMap<u32, Vec2>>> = vec![None; split_count];
         let mut overridden = vec![false; split_count];
         for (i, w) in mesh.wedges.iter().enumerate() {
@@ -242,9 +253,7 @@ impl BaseMesh {
                     "refers to a point or face that does not exist",
                 ));
             }
-            let Some(id) = (0..split_count)
-                .find(|&s| source_point[s] == w.point && wedge_faces[s].contains(&w.face))
-            else {
+            let Some(id) = wedge_at.get(&(w.point, w.face)).map(|&id| id as usize) else {
                 return Err(invalid(what, "the face does not contain the point"));
             };
             if overridden[id] {

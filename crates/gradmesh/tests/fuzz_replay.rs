@@ -1,4 +1,5 @@
-//! Replays the fuzz corpus (`fuzz/corpus/<target>/`, when present) and the regression files
+//! Replays the committed, minimised fuzz corpus (`fuzz/seeds/<target>/`), the working corpus
+//! of a local fuzzing run (`fuzz/corpus/<target>/`, when present) and the regression files
 //! (`tests/regressions/<target>/`: inputs that once crashed a fuzz target) through the same entry
 //! points as the fuzz targets (`tests/fuzz_entry/mod.rs`), so that `cargo test` catches a
 //! regression without cargo-fuzz.
@@ -49,11 +50,9 @@ fn fuzz_corpus_and_regressions_replay_cleanly() {
     let mut failures = Vec::new();
     let mut regressions = 0;
     for target in TARGETS {
-        replay(
-            target,
-            &crate_dir.join("../../fuzz/corpus").join(target),
-            &mut failures,
-        );
+        for corpus in ["../../fuzz/seeds", "../../fuzz/corpus"] {
+            replay(target, &crate_dir.join(corpus).join(target), &mut failures);
+        }
         regressions += replay(
             target,
             &crate_dir.join("tests/regressions").join(target),

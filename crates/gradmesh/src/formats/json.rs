@@ -633,7 +633,7 @@ impl LayerReader<'_> {
         if let Some(v) = corners.iter().find(|&&v| !seen.insert(v)) {
             return Err(self.fail(
                 item("faces", f, &[]),
-                format!("point {v} appears twice: {corners:?}"),
+                format!("point {v} appears twice: {}", short_list(&corners)),
             ));
         }
         Ok(corners)
@@ -691,7 +691,13 @@ impl LayerReader<'_> {
         }
     }
 
-    fn wedge(&self, w: usize, raw: RawWedge, mesh: &GradientMesh) -> Result<WedgeOverride, Error> {
+    fn wedge(
+        &self,
+        w: usize,
+        raw: RawWedge,
+        mesh: &GradientMesh,
+        corners_of: &HashSet<(u32, u32)>,
+    ) -> Result<WedgeOverride, Error> {
         let (point, face) = (raw.point.0, raw.face.0);
         self.check_point(item("wedges", w, &["point"]), point)?;
         let Some(corners) = mesh.faces.get(face as usize) else {
@@ -703,10 +709,13 @@ impl LayerReader<'_> {
                 ),
             ));
         };
-        if !corners.contains(&point) {
+        if !corners_of.contains(&(point, face)) {
             return Err(self.fail(
                 item("wedges", w, &["face"]),
-                format!("face {face} {corners:?} does not contain point {point}"),
+                format!(
+                    "face {face} {} does not contain point {point}",
+                    short_list(corners)
+                ),
             ));
         }
         let (colour, colour_text, alpha) = resolve_colour(raw.colour, mesh.colour_space)
@@ -729,6 +738,17 @@ impl LayerReader<'_> {
             opacity,
             handles,
         })
+    }
+}
+
+/// A list of indices for a message: whole when short, else its start and its length.
+fn short_list(items: &[u32]) -> String {
+    const SHOWN: usize = 12;
+    if items.len() <= SHOWN {
+        format!("{items:?}")
+    } else {
+        let head: Vec<String> = items[..SHOWN].iter().map(u32::to_string).collect();
+        format!("[{}, ... ({} in all)]", head.join(", "), items.len())
     }
 }
 
@@ -795,8 +815,15 @@ fn convert_layer(
     for (e, edge) in raw.edges.into_iter().enumerate() {
         reader.edge(e, edge, &mut mesh)?;
     }
+    // (point, face) of every corner, built only when there are wedge entries to check.
+    let mut corners_of = HashSet::new();
+    if !raw.wedges.is_empty() {
+        for (f, face) in mesh.faces.iter().enumerate() {
+            corners_of.extend(face.iter().map(|&p| (p, f as u32)));
+        }
+    }
     for (w, wedge) in raw.wedges.into_iter().enumerate() {
-        let wedge = reader.wedge(w, wedge, &mesh)?;
+        let wedge = reader.wedge(w, wedge, &mesh, &corners_of)?;
         mesh.wedges.push(wedge);
     }
     Ok(mesh)

@@ -10,7 +10,6 @@
 //! objects, groups, smoothing groups, materials, lines and points are ignored; `#` starts a
 //! comment. When no vertex has a colour, every point is a neutral grey (sRGB 0.5, 0.5, 0.5).
 
-
 use kurbo::Point;
 
 use crate::colour::ColourSpace;
