@@ -195,6 +195,9 @@ pub struct RenderArgs {
     /// Print the time each stage took, and the level drawn for each layer.
     #[arg(long)]
     pub timings: bool,
+    /// The largest image accepted, in pixels (refused before anything is allocated).
+    #[arg(long, value_name = "N", default_value_t = gradmesh::render::MAX_PIXELS, help_heading = "Limits")]
+    pub max_pixels: u64,
     /// Allow the output to be one of the input files.
     #[arg(long)]
     pub force: bool,

@@ -368,3 +368,34 @@ fn info_warns_where_the_surface_folds() {
     let text = String::from_utf8(o.stdout).unwrap();
     assert!(!text.contains("folds over itself"), "{text}");
 }
+
+#[test]
+fn images_beyond_the_pixel_limit_are_refused_up_front() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("big.png");
+    let input = realdata().join("Glasses.off");
+    let o = gradmesh(&["render", s(&input), "-o", s(&out), "--width", "20000"]);
+    assert!(!o.status.success());
+    let msg = stderr(&o);
+    assert!(
+        msg.contains("pixel count") && msg.contains("100,000,000"),
+        "{msg}"
+    );
+    assert!(!out.exists());
+    let o = gradmesh(&[
+        "render",
+        s(&input),
+        "-o",
+        s(&out),
+        "--width",
+        "300",
+        "--max-pixels",
+        "1000",
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("above the limit of 1,000"),
+        "{}",
+        stderr(&o)
+    );
+}

@@ -84,8 +84,8 @@ use view::ToPixels;
 
 /// The largest image side accepted.
 pub const MAX_SIDE: u32 = 1 << 15;
-/// The largest pixel count accepted.
-pub const MAX_PIXELS: u64 = 1 << 28;
+/// The default largest pixel count ([`RenderOptions::max_pixels`]): 100 megapixels.
+pub const MAX_PIXELS: u64 = 100_000_000;
 
 /// How to render a document.
 #[derive(Clone, Debug, PartialEq)]
@@ -129,6 +129,9 @@ pub struct RenderOptions {
     pub blend: BlendSpace,
     /// Dither 8-bit output of [`render_document_into`] (deterministic triangular noise).
     pub dither: bool,
+    /// The largest image accepted, in pixels (default [`MAX_PIXELS`]): a larger request is
+    /// refused before anything is allocated.
+    pub max_pixels: u64,
 }
 
 impl Default for RenderOptions {
@@ -149,6 +152,7 @@ impl Default for RenderOptions {
             gamut: GamutMapping::default(),
             blend: BlendSpace::default(),
             dither: true,
+            max_pixels: MAX_PIXELS,
         }
     }
 }
@@ -200,11 +204,11 @@ impl RenderOptions {
             .into());
         }
         let pixels = self.width as u64 * self.height as u64;
-        if pixels > MAX_PIXELS {
+        if pixels > self.max_pixels {
             return Err(ErrorKind::LimitExceeded {
                 what: "pixel count".into(),
                 found: pixels,
-                limit: MAX_PIXELS,
+                limit: self.max_pixels,
             }
             .into());
         }
