@@ -382,69 +382,8 @@ mod tests {
         let faces = vec![vec![0, 1, 2, 3], vec![1, 4, 2], vec![2, 4, 5, 6, 3]];
         let t = Topology::from_faces(7, &faces).unwrap();
         let child = ternary_topology(&t);
-        let offsets: Vec<u32> = (0..=child.face_count())
-            .map(|f| {
-                if f == child.face_count() {
-                    child.corner_count() as u32
-                } else {
-                    child.face_offset(f) as u32
-                }
-            })
-            .collect();
-        let verts: Vec<u32> = (0..child.face_count())
-            .flat_map(|f| child.face_vertices(f).to_vec())
-            .collect();
-        let rebuilt = Topology::build(child.vertex_count(), offsets, verts, |_, _| false).unwrap();
-        assert_eq!(child.edge_count(), rebuilt.edge_count());
+        child.assert_matches_a_rebuild();
         assert_eq!(child.euler_characteristic(), t.euler_characteristic());
-        let ends = |t: &Topology, e: u32| {
-            let [a, b] = t.edge_vertices(e as usize);
-            (a.min(b), a.max(b))
-        };
-        for f in 0..child.face_count() {
-            for (e1, e2) in child.face_edges(f).iter().zip(rebuilt.face_edges(f)) {
-                assert_eq!(ends(&child, *e1), ends(&rebuilt, *e2), "face {f}");
-            }
-        }
-        for e in 0..child.edge_count() {
-            let [a, b] = child.edge_vertices(e);
-            let [f0, f1] = child.edge_faces(e);
-            let fv = child.face_vertices(f0 as usize);
-            let k = fv.iter().position(|&x| x == a).unwrap();
-            assert_eq!(
-                fv[(k + 1) % fv.len()],
-                b,
-                "edge {e} runs a->b in its first face"
-            );
-            if f1 != INVALID {
-                let fv = child.face_vertices(f1 as usize);
-                let k = fv.iter().position(|&x| x == b).unwrap();
-                assert_eq!(fv[(k + 1) % fv.len()], a);
-            }
-            let twin = (0..rebuilt.edge_count())
-                .find(|&r| ends(&rebuilt, r as u32) == ends(&child, e as u32))
-                .unwrap();
-            assert_eq!(child.is_boundary_edge(e), rebuilt.is_boundary_edge(twin));
-        }
-        for v in 0..child.vertex_count() {
-            assert_eq!(
-                child.is_boundary_vertex(v),
-                rebuilt.is_boundary_vertex(v),
-                "{v}"
-            );
-            let mut f1 = child.vertex_faces(v).to_vec();
-            let f2 = rebuilt.vertex_faces(v).to_vec();
-            if !child.is_boundary_vertex(v) {
-                let k = f1.iter().position(|&f| f == f2[0]).unwrap();
-                f1.rotate_left(k);
-            }
-            assert_eq!(f1, f2, "ring of {v}");
-            let edges = child.vertex_edges(v);
-            for (k, &f) in child.vertex_faces(v).iter().enumerate() {
-                let fe = child.face_edges(f as usize);
-                assert!(fe.contains(&edges[k]) && fe.contains(&edges[(k + 1) % edges.len()]));
-            }
-        }
     }
 
     #[test]

@@ -545,6 +545,68 @@ impl Topology {
         }
     }
 
+    /// Checks that this topology (built directly by a refinement step) has the connectivity
+    /// that [`Topology::build`] finds from its faces: the same edges around every face, edges
+    /// running `a -> b` in their first face, boundary flags, and rings in cyclic order.
+    #[cfg(test)]
+    pub(crate) fn assert_matches_a_rebuild(&self) {
+        let child = self;
+        let (o, v) = (child.face_offsets.clone(), child.face_verts.clone());
+        let rebuilt = Topology::build(child.vertex_count(), o, v, |_, _| false).unwrap();
+        assert_eq!(child.face_count(), rebuilt.face_count());
+        assert_eq!(child.edge_count(), rebuilt.edge_count());
+        // Edge ids differ between the two: compare edges by their end vertices.
+        let ends = |t: &Topology, e: u32| {
+            let [a, b] = t.edge_vertices(e as usize);
+            (a.min(b), a.max(b))
+        };
+        for f in 0..child.face_count() {
+            for (e1, e2) in child.face_edges(f).iter().zip(rebuilt.face_edges(f)) {
+                assert_eq!(ends(child, *e1), ends(&rebuilt, *e2), "face {f}");
+            }
+        }
+        for e in 0..child.edge_count() {
+            let [a, b] = child.edge_vertices(e);
+            let [f0, f1] = child.edge_faces(e);
+            let runs = |f: u32, from: u32, to: u32| {
+                let fv = child.face_vertices(f as usize);
+                let k = fv.iter().position(|&x| x == from).unwrap();
+                fv[(k + 1) % fv.len()] == to
+            };
+            assert!(runs(f0, a, b), "edge {e} runs a->b in its first face");
+            if f1 != INVALID {
+                assert!(runs(f1, b, a), "edge {e} runs b->a in its second face");
+            }
+        }
+        for v in 0..child.vertex_count() {
+            assert_eq!(
+                child.is_boundary_vertex(v),
+                rebuilt.is_boundary_vertex(v),
+                "{v}"
+            );
+            let mut f1 = child.vertex_faces(v).to_vec();
+            let f2 = rebuilt.vertex_faces(v).to_vec();
+            // Same cyclic order, possibly rotated for interior vertices.
+            if !child.is_boundary_vertex(v) && !f1.is_empty() {
+                let k = f1.iter().position(|&f| f == f2[0]).unwrap();
+                f1.rotate_left(k);
+            }
+            assert_eq!(f1, f2, "ring of {v}");
+            for (&f, &c) in child
+                .vertex_faces(v)
+                .iter()
+                .zip(child.vertex_face_corners(v))
+            {
+                assert_eq!(child.face_vertices(f as usize)[c as usize], v as u32);
+            }
+            let edges = child.vertex_edges(v);
+            for (k, &f) in child.vertex_faces(v).iter().enumerate() {
+                let fe = child.face_edges(f as usize);
+                assert!(fe.contains(&edges[k]) && fe.contains(&edges[(k + 1) % edges.len()]));
+            }
+        }
+    }
+
     /// Whether every face is a quad.
     pub fn is_all_quads(&self) -> bool {
         (0..self.face_count()).all(|f| self.face_vertices(f).len() == 4)
@@ -643,60 +705,7 @@ mod tests {
         for faces in [faces, mixed] {
             let t = Topology::from_faces(16, &faces).unwrap();
             let child = t.subdivide();
-            let (o, v) = (child.face_offsets.clone(), child.face_verts.clone());
-            let rebuilt = Topology::build(child.vertex_count(), o, v, |_, _| false).unwrap();
-            assert_eq!(child.face_count(), rebuilt.face_count());
-            assert_eq!(child.edge_count(), rebuilt.edge_count());
-            // Same edges around every face (edge ids differ: compare by end vertices).
-            let ends = |t: &Topology, e: u32| {
-                let [a, b] = t.edge_vertices(e as usize);
-                (a.min(b), a.max(b))
-            };
-            for f in 0..child.face_count() {
-                for (e1, e2) in child.face_edges(f).iter().zip(rebuilt.face_edges(f)) {
-                    assert_eq!(ends(&child, *e1), ends(&rebuilt, *e2));
-                }
-            }
-            for e in 0..child.edge_count() {
-                let [a, b] = child.edge_vertices(e);
-                let [f0, f1] = child.edge_faces(e);
-                // f0 runs a->b.
-                let fv = child.face_vertices(f0 as usize);
-                let k = fv.iter().position(|&x| x == a).unwrap();
-                assert_eq!(fv[(k + 1) % 4], b);
-                if f1 != INVALID {
-                    let fv = child.face_vertices(f1 as usize);
-                    let k = fv.iter().position(|&x| x == b).unwrap();
-                    assert_eq!(fv[(k + 1) % 4], a);
-                }
-            }
-            for v in 0..child.vertex_count() {
-                assert_eq!(
-                    child.is_boundary_vertex(v),
-                    rebuilt.is_boundary_vertex(v),
-                    "{v}"
-                );
-                let mut f1 = child.vertex_faces(v).to_vec();
-                let f2 = rebuilt.vertex_faces(v).to_vec();
-                // Same cyclic order, possibly rotated for interior vertices.
-                if !child.is_boundary_vertex(v) {
-                    let k = f1.iter().position(|&f| f == f2[0]).unwrap();
-                    f1.rotate_left(k);
-                }
-                assert_eq!(f1, f2, "ring of {v}");
-                for (&f, &c) in child
-                    .vertex_faces(v)
-                    .iter()
-                    .zip(child.vertex_face_corners(v))
-                {
-                    assert_eq!(child.face_vertices(f as usize)[c as usize], v as u32);
-                }
-                let edges = child.vertex_edges(v);
-                for (k, &f) in child.vertex_faces(v).iter().enumerate() {
-                    let fe = child.face_edges(f as usize);
-                    assert!(fe.contains(&edges[k]) && fe.contains(&edges[(k + 1) % edges.len()]));
-                }
-            }
+            child.assert_matches_a_rebuild();
         }
     }
 
