@@ -150,8 +150,8 @@ pub fn binary_topology(t: &Topology) -> Topology {
         ring_offsets.push(ring_faces.len() as u32);
         edge_ring_offsets.push(ring_edges.len() as u32);
     }
-    Topology::from_parts(
-        count,
+    Topology {
+        vertex_count: count,
         face_offsets,
         face_verts,
         face_edges,
@@ -162,7 +162,8 @@ pub fn binary_topology(t: &Topology) -> Topology {
         ring_corners,
         edge_ring_offsets,
         ring_edges,
-    )
+    }
+    .debug_checked()
 }
 
 /// The level-1 topology and sharpness of `base`: [`binary_topology`], with the four level-1

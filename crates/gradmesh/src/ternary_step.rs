@@ -269,7 +269,7 @@ pub fn ternary_topology(t: &Topology) -> Topology {
         );
     }
 
-    Topology::from_parts(
+    Topology {
         vertex_count,
         face_offsets,
         face_verts,
@@ -281,7 +281,8 @@ pub fn ternary_topology(t: &Topology) -> Topology {
         ring_corners,
         edge_ring_offsets,
         ring_edges,
-    )
+    }
+    .debug_checked()
 }
 
 /// The position of the face point at corner `V0` of a face (the bilinear rule of section 4.3,

@@ -11,21 +11,21 @@ pub const INVALID: u32 = u32::MAX;
 /// The connectivity of a polygon mesh with boundaries.
 #[derive(Clone, Debug, Default)]
 pub struct Topology {
-    vertex_count: usize,
-    face_offsets: Vec<u32>,
-    face_verts: Vec<u32>,
+    pub(crate) vertex_count: usize,
+    pub(crate) face_offsets: Vec<u32>,
+    pub(crate) face_verts: Vec<u32>,
     /// Edge from corner `i` to corner `i + 1` of each face, parallel to `face_verts`.
-    face_edges: Vec<u32>,
-    edge_verts: Vec<[u32; 2]>,
+    pub(crate) face_edges: Vec<u32>,
+    pub(crate) edge_verts: Vec<[u32; 2]>,
     /// `[face running v0->v1, face running v1->v0]`; the second is `INVALID` on a boundary.
-    edge_faces: Vec<[u32; 2]>,
+    pub(crate) edge_faces: Vec<[u32; 2]>,
     /// Ordered ring around each vertex: face `k` lies between ring edges `k` and `k + 1`.
-    ring_offsets: Vec<u32>,
-    ring_faces: Vec<u32>,
+    pub(crate) ring_offsets: Vec<u32>,
+    pub(crate) ring_faces: Vec<u32>,
     /// Corner index of the vertex inside each ring face, parallel to `ring_faces`.
-    ring_corners: Vec<u32>,
-    edge_ring_offsets: Vec<u32>,
-    ring_edges: Vec<u32>,
+    pub(crate) ring_corners: Vec<u32>,
+    pub(crate) edge_ring_offsets: Vec<u32>,
+    pub(crate) ring_edges: Vec<u32>,
 }
 
 impl Topology {
@@ -349,42 +349,16 @@ impl Topology {
         used as i64 - self.edge_count() as i64 + self.face_count() as i64
     }
 
-    /// Assembles a topology from arrays a refinement step built directly (the same layout as
-    /// [`Topology::build`] produces). Debug builds check the rings against the faces.
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn from_parts(
-        vertex_count: usize,
-        face_offsets: Vec<u32>,
-        face_verts: Vec<u32>,
-        face_edges: Vec<u32>,
-        edge_verts: Vec<[u32; 2]>,
-        edge_faces: Vec<[u32; 2]>,
-        ring_offsets: Vec<u32>,
-        ring_faces: Vec<u32>,
-        ring_corners: Vec<u32>,
-        edge_ring_offsets: Vec<u32>,
-        ring_edges: Vec<u32>,
-    ) -> Topology {
-        let t = Topology {
-            vertex_count,
-            face_offsets,
-            face_verts,
-            face_edges,
-            edge_verts,
-            edge_faces,
-            ring_offsets,
-            ring_faces,
-            ring_corners,
-            edge_ring_offsets,
-            ring_edges,
-        };
+    /// Checks, in debug builds, that a topology a refinement step assembled field by field
+    /// is consistent: every ring corner names its vertex.
+    pub(crate) fn debug_checked(self) -> Topology {
         #[cfg(debug_assertions)]
-        for v in 0..t.vertex_count {
-            for (&f, &c) in t.vertex_faces(v).iter().zip(t.vertex_face_corners(v)) {
-                debug_assert_eq!(t.face_vertices(f as usize)[c as usize], v as u32);
+        for v in 0..self.vertex_count {
+            for (&f, &c) in self.vertex_faces(v).iter().zip(self.vertex_face_corners(v)) {
+                debug_assert_eq!(self.face_vertices(f as usize)[c as usize], v as u32);
             }
         }
-        t
+        self
     }
 
     /// The topology after one Catmull-Clark split, built directly from this one (no search
