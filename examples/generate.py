@@ -207,6 +207,32 @@ def irregular_vertex(name, spread, note):
     write(name, [layer(pts, faces, name)], note)
 
 
+def multires():
+    """Figure 10: detail added to the sparse mesh of Figure 2 by a few colour edits after two
+    steps (level 2) and one after three, geometry edited on the control mesh only."""
+    P = [(60, 60), (200, 30), (340, 70), (380, 200), (320, 330), (190, 370), (60, 320), (30, 190),
+         (150, 150), (260, 160), (210, 260), (120, 250)]
+    C = ["#264653", "#2a9d8f", "#8ecae6", "#264653", "#6a4c93", "#e63946", "#fb8500", "#f1c453",
+         "#ffffff", "#ffb703", "#e63946", "#2a9d8f"]
+    pts = [pt(x, y, c) for (x, y), c in zip(P, C)]
+    faces = [[0, 1, 9, 8], [1, 2, 3, 9], [9, 3, 4, 10], [10, 4, 5], [11, 10, 5, 6],
+             [7, 8, 9, 10, 11], [0, 8, 7], [7, 11, 6]]
+    edits = [
+        # A dark eye in the pentagon, pinned outright, with a white glint one level down.
+        {"level": 2, "face": 5, "point": 8, "at": [3, 3], "colour": "#1d3557"},
+        {"level": 3, "face": 5, "point": 8, "at": [5, 5], "colour": "#ffffff"},
+        # A band of shade across the upper right quad, relative to what the coarse mesh gives.
+        {"level": 2, "face": 1, "point": 2, "at": [1, 2], "colour_offset": [-30, 0, 0]},
+        {"level": 2, "face": 1, "point": 2, "at": [2, 2], "colour_offset": [-30, 0, 0]},
+        {"level": 2, "face": 1, "point": 2, "at": [3, 2], "colour_offset": [-30, 0, 0]},
+        # A warm spot in the lower left quad and a faded one in the triangle at the bottom.
+        {"level": 2, "face": 4, "point": 6, "at": [2, 2], "colour": "#ffd166"},
+        {"level": 2, "face": 3, "point": 5, "at": [2, 2], "opacity": 0.2},
+    ]
+    write("multires", [layer(pts, faces, "multires", fine_edits="colour-only", edits=edits)],
+          "Figure 10: a few colour edits after two subdivision steps add detail to a sparse mesh")
+
+
 if __name__ == "__main__":
     rectangle()
     annulus()
@@ -219,5 +245,6 @@ if __name__ == "__main__":
     fold("fold-fixed", 170, "Figure 9 (right): the same mesh made more convex: no fold")
     irregular_vertex("irregular-vertex", [0.33, 0.33, 0.33, 0.33, 0.33],
                      "Figure 13: a valence-5 vertex with default handles")
+    multires()
     irregular_vertex("irregular-vertex-spread", [0.45, 0.1, 0.45, 0.1, 0.45],
                      "Figure 13: the same vertex, long handles on three edges spread its red there")

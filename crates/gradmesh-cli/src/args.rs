@@ -25,6 +25,8 @@ pub enum Command {
     Refine(RefineArgs),
     /// Render the limit surface of meshes, drawn in order as layers, to a PNG.
     Render(RenderArgs),
+    /// List the multi-resolution edits of a mesh: the vertex each names, and what it changes.
+    Edits(EditsArgs),
 }
 
 /// Limits on the input (`gradmesh::Limits`), raised for trusted input.
@@ -94,6 +96,16 @@ pub struct InfoArgs {
     /// Input files (.json, .off, .obj).
     #[arg(required = true)]
     pub inputs: Vec<PathBuf>,
+    /// Limits.
+    #[command(flatten)]
+    pub limits: LimitArgs,
+}
+
+/// `gradmesh edits`.
+#[derive(Debug, Args)]
+pub struct EditsArgs {
+    /// Input file (.json).
+    pub input: PathBuf,
     /// Limits.
     #[command(flatten)]
     pub limits: LimitArgs,

@@ -399,3 +399,46 @@ fn images_beyond_the_pixel_limit_are_refused_up_front() {
         stderr(&o)
     );
 }
+
+#[test]
+fn edits_are_listed_and_applied_by_refine() {
+    let example = PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/multires.json"
+    ));
+    let out = gradmesh(&["edits", s(&example)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains("layer 0 (multires): 7 edits, colour-only"),
+        "{text}"
+    );
+    assert!(
+        text.contains("edit 2: level 2, face 1 at point 2, [1, 2]: vertex 141 at (301.111, 78.333): colour + [-30, 0, 0] (lab)"),
+        "{text}"
+    );
+
+    // The refined level 3 differs from that of the same mesh without edits.
+    let dir = tempfile::tempdir().unwrap();
+    let mut plain: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&example).unwrap()).unwrap();
+    plain["layers"][0].as_object_mut().unwrap().remove("edits");
+    let plain_path = dir.path().join("plain.json");
+    std::fs::write(&plain_path, plain.to_string()).unwrap();
+    let refined = |input: &Path, name: &str| {
+        let output = dir.path().join(name);
+        let out = gradmesh(&["refine", s(input), "-o", s(&output), "--levels", "3"]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        std::fs::read_to_string(output).unwrap()
+    };
+    let (a, b) = (refined(&example, "a.obj"), refined(&plain_path, "b.obj"));
+    assert_eq!(a.lines().count(), b.lines().count());
+    let differing = a.lines().zip(b.lines()).filter(|(x, y)| x != y).count();
+    assert!(
+        differing > 10 && differing < a.lines().count() / 4,
+        "{differing}"
+    );
+
+    let out = gradmesh(&["edits", s(&plain_path)]);
+    assert!(String::from_utf8(out.stdout).unwrap().contains("no edits"));
+}

@@ -9,7 +9,8 @@
 //!    (or [`binary_step`](mod@binary_step), the paper's alternative of two binary splits);
 //! 3. [`catmull_clark`](mod@catmull_clark): Catmull-Clark refinement with Pixar's rules, topology refined once and
 //!    data interpolated with precomputed stencils;
-//! 4. [`limit`](mod@limit): limit positions and colours of refined vertices.
+//! 4. [`edits`](mod@edits): multi-resolution edits, applied to refined levels between steps;
+//! 5. [`limit`](mod@limit): limit positions and colours of refined vertices.
 //!
 //! ```
 //! use gradmesh::{refine::Refinement, ColourSpace, GradientMesh};
@@ -34,6 +35,7 @@
 pub mod binary_step;
 pub mod catmull_clark;
 pub mod colour;
+pub mod edits;
 pub mod error;
 pub mod formats;
 pub mod limit;
@@ -47,6 +49,7 @@ pub mod topology;
 pub mod validate;
 
 pub use colour::ColourSpace;
+pub use edits::{ColourEdit, Edit, FineEdits, OpacityEdit, VertexAddress};
 pub use error::{Error, ErrorKind, Location, Result, Warning};
 pub use limits::Limits;
 pub use mesh::{

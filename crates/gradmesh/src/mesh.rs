@@ -5,6 +5,7 @@ use std::collections::BTreeMap;
 use kurbo::{Point, Vec2};
 
 use crate::colour::ColourSpace;
+use crate::edits::{Edit, FineEdits, VertexAddress};
 
 /// Sharpness at or above this value is infinite (OpenSubdiv's `SHARPNESS_INFINITE`).
 pub const SHARPNESS_INFINITE: f64 = 10.0;
@@ -203,6 +204,10 @@ pub struct GradientMesh {
     pub edges: BTreeMap<(u32, u32), EdgeTag>,
     /// Per-side colours and handles at discontinuous edges.
     pub wedges: Vec<WedgeOverride>,
+    /// Multi-resolution edits of refined vertices (see [`crate::edits`]), at most one per vertex.
+    pub edits: Vec<Edit>,
+    /// Which edits the mesh allows below level 0.
+    pub fine_edits: FineEdits,
 }
 
 impl Default for GradientMesh {
@@ -219,6 +224,8 @@ impl Default for GradientMesh {
             handles: BTreeMap::new(),
             edges: BTreeMap::new(),
             wedges: Vec::new(),
+            edits: Vec::new(),
+            fine_edits: FineEdits::ColourAndPosition,
         }
     }
 }
@@ -287,6 +294,29 @@ impl GradientMesh {
     /// Sets the handle of point `from` along its edge towards `to`.
     pub fn set_handle(&mut self, from: u32, to: u32, handle: Vec2) {
         self.handles.insert((from, to), handle);
+    }
+
+    /// The edit of the vertex named `address`, if any (the name as written: a vertex on a
+    /// sector's side has other names too).
+    pub fn edit(&self, address: &VertexAddress) -> Option<&Edit> {
+        self.edits.iter().find(|e| e.address == *address)
+    }
+
+    /// Adds `edit`, or replaces the edit with the same address; returns the one replaced.
+    pub fn set_edit(&mut self, edit: Edit) -> Option<Edit> {
+        match self.edits.iter_mut().find(|e| e.address == edit.address) {
+            Some(old) => Some(std::mem::replace(old, edit)),
+            None => {
+                self.edits.push(edit);
+                None
+            }
+        }
+    }
+
+    /// Removes the edit with `address`; returns it.
+    pub fn remove_edit(&mut self, address: &VertexAddress) -> Option<Edit> {
+        let i = self.edits.iter().position(|e| e.address == *address)?;
+        Some(self.edits.remove(i))
     }
 
     /// Number of corners over all faces.

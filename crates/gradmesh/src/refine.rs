@@ -8,6 +8,8 @@
 
 use crate::binary_step;
 use crate::catmull_clark::{self, Level, Stencils};
+use crate::colour::ColourSpace;
+use crate::edits::{self, Edit, FineEdits};
 use crate::error::{Error, Warning};
 use crate::limit;
 use crate::limits::Limits;
@@ -140,32 +142,111 @@ impl Refinement {
     }
 
     /// Evaluates every level from other base data on the same topology (for example after an
-    /// edit of positions, colours or handles): no topology is rebuilt.
+    /// edit of positions, colours, handles or multi-resolution edits): no topology is rebuilt.
+    ///
+    /// # Panics
+    /// If `base` has another topology than the one refined.
     pub fn evaluate_with(&self, base: &BaseMesh) -> RefinedMesh {
         let mut levels = vec![base.data.clone()];
         if !self.levels.is_empty() {
-            let mut level1 = first_data(base);
-            if let Some((d, limit)) = &self.interpolation {
-                self.interpolate_positions(base, *d, limit, &mut level1);
-            }
-            levels.push(level1);
+            levels.push(self.first_level_data(base));
         }
-        for st in &self.stencils {
-            let next = st.apply(levels.last().expect("level 1"));
+        for k in 1..self.levels.len() {
+            let next = self.next_level_data_with(base, k, &levels[k]);
             levels.push(next);
         }
         RefinedMesh { levels }
     }
 
+    /// The level-1 data of `base`: the first step, the position correction when positions are
+    /// interpolated, and the level-1 edits.
+    fn first_level_data(&self, base: &BaseMesh) -> Vec<VertexData> {
+        let mut level1 = first_data(base);
+        if let Some((d, limit)) = &self.interpolation {
+            self.interpolate_positions(base, *d, limit, &mut level1);
+        }
+        self.apply_edits(base, 1, None, &mut level1);
+        level1
+    }
+
+    /// The data of level `k + 1` (`k >= 1`) from that of level `k`: one Catmull-Clark step, then
+    /// the multi-resolution edits. Level `k + 1` must be built ([`Refinement::extend_to`]).
+    /// Renderers and writers that go one level further should use this, not the bare stencils,
+    /// so that edits apply.
+    pub fn next_level_data(&self, k: usize, data: &[VertexData]) -> Vec<VertexData> {
+        self.next_level_data_with(&self.base, k, data)
+    }
+
+    /// As [`Refinement::next_level_data`], with the edits of other base data.
+    pub fn next_level_data_with(
+        &self,
+        base: &BaseMesh,
+        k: usize,
+        data: &[VertexData],
+    ) -> Vec<VertexData> {
+        let mut next = self.stencils(k).apply(data);
+        self.apply_edits(base, k + 1, Some(data), &mut next);
+        next
+    }
+
+    /// Applies the edits of level `k` (and the rings of those of level `k - 1`).
+    fn apply_edits(
+        &self,
+        base: &BaseMesh,
+        k: usize,
+        previous: Option<&[VertexData]>,
+        data: &mut [VertexData],
+    ) {
+        if base.edits.is_empty() || base.edits.deepest_level() + 1 < k {
+            return;
+        }
+        let levels: Vec<&Topology> = self.levels[..k].iter().map(|l| &l.topology).collect();
+        edits::apply(base, &levels, &base.edits, k, previous, data);
+    }
+
+    /// The index at its level of the vertex that edit `i` of the base level names, building the
+    /// topology down to that level if needed.
+    pub fn edited_vertex(&mut self, i: usize) -> Option<usize> {
+        let edit = self.base.edits.edits.get(i)?.clone();
+        self.extend_to(edit.edit.address.level as usize);
+        let levels: Vec<&Topology> = self.levels.iter().map(|l| &l.topology).collect();
+        edits::vertex_of(&self.base.topology, &levels, &edit).map(|v| v as usize)
+    }
+
+    /// Replaces the multi-resolution edits (checked against the base level); the next
+    /// [`Refinement::evaluate`] applies them. No topology is rebuilt.
+    pub fn set_edits(&mut self, edits: &[Edit], fine: FineEdits) -> Result<(), Error> {
+        let space = self.base.edits.space;
+        let working = self.base.edits.working;
+        let mut set = edits::check_edits(&self.base, edits, fine, space)?;
+        set.working = working;
+        self.base.edits = set;
+        Ok(())
+    }
+
+    /// Declares that the edits' colours are written in `space` while the data is in another
+    /// working space (a renderer that interpolates a mesh in another space converts the points'
+    /// colours, then says in which space the edits were written).
+    pub fn set_edit_colour_space(&mut self, space: ColourSpace) {
+        self.base.edits.space = space;
+    }
+
     /// The limit position, colour and opacity of every vertex of level `k`, refining one or two
-    /// levels further where level `k` still has faces that are not quads.
+    /// levels further where level `k` still has faces that are not quads, and below the
+    /// deepest edit.
     pub fn limit(&mut self, data: &RefinedMesh, k: usize) -> Vec<VertexData> {
         // Vertex v of level j has the vertex point nf + ne + v at level j + 1 (j >= 1), and
         // vertex point v at level 1 (j = 0); both have the same limit.
         let mut j = k;
         let mut index: Vec<u32> = (0..self.topology(k).vertex_count() as u32).collect();
+        // Edits of level `d` change the data of level `d + 1` (their rings) and below: the limit
+        // stencils apply from there on.
+        let exact_from = match self.base.edits.deepest_level() {
+            0 => 0,
+            d => d + 1,
+        };
         loop {
-            if j >= 1 {
+            if j >= 1 && j >= exact_from {
                 if let Some(st) = limit::limit_stencils(self.level(j)) {
                     let at_j = self.level_data(data, j);
                     let all = st.apply(&at_j);
@@ -232,11 +313,11 @@ impl Refinement {
         let mut d = data.levels.last().expect("level 0").clone();
         let mut at = data.levels.len() - 1;
         if at == 0 {
-            d = first_data(&self.base);
+            d = self.first_level_data(&self.base);
             at = 1;
         }
         while at < j {
-            d = self.stencils(at).apply(&d);
+            d = self.next_level_data(at, &d);
             at += 1;
         }
         d

@@ -8,6 +8,7 @@ use std::collections::{BTreeMap, HashMap};
 
 use kurbo::Vec2;
 
+use crate::edits::{check_edits, EditSet};
 use crate::error::{Error, ErrorKind, Warning};
 use crate::mesh::{
     edge_key, BoundaryInterpolation, CreasingMethod, EdgeKind, FirstStep, GradientMesh,
@@ -58,6 +59,8 @@ pub struct BaseMesh {
     pub interpolate_positions: bool,
     /// The special first refinement (level 1).
     pub first_step: FirstStep,
+    /// The multi-resolution edits, checked.
+    pub edits: EditSet,
 }
 
 fn not_finite(what: String, value: f64) -> Error {
@@ -355,9 +358,14 @@ impl BaseMesh {
                 creasing: mesh.creasing,
                 interpolate_positions: mesh.interpolate_positions,
                 first_step: mesh.first_step,
+                edits: EditSet::default(),
             },
             warnings,
         ))
+        .and_then(|(mut base, warnings)| {
+            base.edits = check_edits(&base, &mesh.edits, mesh.fine_edits, mesh.colour_space)?;
+            Ok((base, warnings))
+        })
     }
 }
 

@@ -420,7 +420,7 @@ fn refined_outputs_are_written() {
 fn the_example_of_the_specification_reads_and_validates() {
     let spec =
         fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/format.md")).unwrap();
-    let section = &spec[spec.find("### 1.8 Example").expect("section 1.8")..];
+    let section = &spec[spec.find("### 1.9 Example").expect("section 1.9")..];
     let start = section.find("```json\n").unwrap() + "```json\n".len();
     let text = &section[start..start + section[start..].find("```").unwrap()];
     let doc = json::read_document(text).unwrap_or_else(|e| panic!("{e}"));

@@ -154,6 +154,7 @@ examples! {
     handles_short => "handles-short",
     irregular_vertex => "irregular-vertex",
     irregular_vertex_spread => "irregular-vertex-spread",
+    multires => "multires",
     non_rectangular => "non-rectangular",
     rectangle => "rectangle",
     sparse_irregular => "sparse-irregular",

@@ -1,6 +1,7 @@
 //! The subcommands, each turning parsed flags into library calls.
 
 mod convert;
+mod edits;
 mod info;
 mod refine;
 mod render;
@@ -18,6 +19,7 @@ pub fn run(cli: Cli) -> Result<(), Error> {
         Command::Convert(a) => convert::run(&a),
         Command::Refine(a) => refine::run(&a),
         Command::Render(a) => render::run(&a),
+        Command::Edits(a) => edits::run(&a),
     }
 }
 

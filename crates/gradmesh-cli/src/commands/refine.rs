@@ -37,6 +37,15 @@ pub fn run(args: &RefineArgs) -> Result<(), Error> {
                 .map_err(locate)?;
         }
         super::print_warnings(&args.input, &warnings);
+        let deepest = refinement.base().edits.deepest_level();
+        if deepest > args.levels && !args.limit {
+            eprintln!(
+                "gradmesh: warning: {}: layer {i}: edits down to level {deepest} lie below the \
+                 level written ({}) and have no effect on it",
+                args.input.display(),
+                args.levels
+            );
+        }
         let mut data = refinement.evaluate();
         let points = if args.limit {
             refinement.limit(&data, args.levels)

@@ -13,6 +13,7 @@ use kurbo::{Point, Vec2};
 use serde::de::{self, Deserialize, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
 
 use crate::colour::{parse_css_colour, ColourSpace};
+use crate::edits::{ColourEdit, Edit, FineEdits, OpacityEdit, VertexAddress};
 use crate::error::{Error, ErrorKind, Location};
 use crate::limits::Limits;
 use crate::mesh::{
@@ -228,6 +229,29 @@ struct RawLayer {
     edges: Vec<RawEdge>,
     #[serde(default)]
     wedges: Vec<RawWedge>,
+    #[serde(default)]
+    fine_edits: Option<String>,
+    #[serde(default)]
+    edits: Vec<RawEdit>,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields, rename = "edit object")]
+struct RawEdit {
+    level: Index,
+    face: Index,
+    point: Index,
+    at: IndexPair,
+    #[serde(default)]
+    colour: Option<RawColour>,
+    #[serde(default)]
+    colour_offset: Option<Numbers<3>>,
+    #[serde(default)]
+    opacity: Option<Num>,
+    #[serde(default)]
+    opacity_offset: Option<Num>,
+    #[serde(default)]
+    offset: Option<Numbers<2>>,
 }
 
 #[derive(serde::Deserialize)]
@@ -741,6 +765,49 @@ impl LayerReader<'_> {
     }
 }
 
+impl LayerReader<'_> {
+    fn edit(&self, i: usize, raw: RawEdit, space: ColourSpace) -> Result<Edit, Error> {
+        let at = |field: &str| item("edits", i, &[field]);
+        let both = |a: &str, b: &str| {
+            self.fail(
+                item("edits", i, &[]),
+                format!("give \"{a}\" (absolute) or \"{b}\" (relative), not both"),
+            )
+        };
+        let colour = match (raw.colour, raw.colour_offset) {
+            (Some(_), Some(_)) => return Err(both("colour", "colour_offset")),
+            (Some(c), None) => {
+                let (c, _, alpha) =
+                    resolve_colour(c, space).map_err(|m| self.fail(at("colour"), m))?;
+                if alpha < 1.0 {
+                    return Err(self.fail(
+                        at("colour"),
+                        "a colour with alpha: give the opacity in \"opacity\"".into(),
+                    ));
+                }
+                Some(ColourEdit::Set(c))
+            }
+            (None, Some(d)) => Some(ColourEdit::Offset(d.0)),
+            (None, None) => None,
+        };
+        let opacity = match (raw.opacity, raw.opacity_offset) {
+            (Some(_), Some(_)) => return Err(both("opacity", "opacity_offset")),
+            (Some(Num(o)), None) => {
+                self.check_opacity(at("opacity"), o)?;
+                Some(OpacityEdit::Set(o))
+            }
+            (None, Some(Num(d))) => Some(OpacityEdit::Offset(d)),
+            (None, None) => None,
+        };
+        Ok(Edit {
+            address: VertexAddress::new(raw.level.0, raw.face.0, raw.point.0, raw.at.0),
+            colour,
+            opacity,
+            offset: raw.offset.map(|o| Vec2::new(o.0[0], o.0[1])),
+        })
+    }
+}
+
 /// A list of indices for a message: whole when short, else its start and its length.
 fn short_list(items: &[u32]) -> String {
     const SHOWN: usize = 12;
@@ -771,6 +838,7 @@ fn convert_layer(
     .map(|b| (b.name(), b));
     let creasings = [CreasingMethod::Uniform, CreasingMethod::Chaikin].map(|c| (c.name(), c));
     let first_steps = [FirstStep::Ternary, FirstStep::Binary].map(|s| (s.name(), s));
+    let fine = [FineEdits::ColourAndPosition, FineEdits::ColourOnly].map(|f| (f.name(), f));
 
     let limit = |e: Error, field: &str| {
         let path = item("layers", layer, &[field]);
@@ -793,6 +861,8 @@ fn convert_layer(
         .map_err(|e| limit(e, "faces"))?;
     let corners = raw.faces.iter().map(|f| f.len() as u64).sum();
     check_count("the number of corners", corners, limits.corners).map_err(|e| limit(e, "faces"))?;
+    check_count("the number of edits", raw.edits.len() as u64, limits.points)
+        .map_err(|e| limit(e, "edits"))?;
 
     let mut mesh = GradientMesh {
         name: raw.name,
@@ -801,6 +871,7 @@ fn convert_layer(
         creasing: reader.named("creasing", raw.creasing.as_deref(), &creasings)?,
         interpolate_positions: raw.interpolate_positions,
         first_step: reader.named("first_step", raw.first_step.as_deref(), &first_steps)?,
+        fine_edits: reader.named("fine_edits", raw.fine_edits.as_deref(), &fine)?,
         points: Vec::with_capacity(raw.points.len()),
         faces: Vec::with_capacity(raw.faces.len()),
         ..GradientMesh::default()
@@ -825,6 +896,10 @@ fn convert_layer(
     for (w, wedge) in raw.wedges.into_iter().enumerate() {
         let wedge = reader.wedge(w, wedge, &mesh, &corners_of)?;
         mesh.wedges.push(wedge);
+    }
+    for (i, edit) in raw.edits.into_iter().enumerate() {
+        let edit = reader.edit(i, edit, mesh.colour_space)?;
+        mesh.edits.push(edit);
     }
     Ok(mesh)
 }
@@ -1003,6 +1078,7 @@ fn describe(path: &[Seg]) -> (Option<usize>, String) {
         "faces" => Some("face"),
         "edges" => Some("edge entry"),
         "wedges" => Some("wedge"),
+        "edits" => Some("edit"),
         "handles" => Some("handle"),
         _ => None,
     };
@@ -1350,7 +1426,38 @@ fn write_layer(mesh: &GradientMesh, indent: usize) -> String {
     if !wedges.is_empty() {
         fields.push(("wedges", block_array(indent + 2, wedges)));
     }
+    if mesh.fine_edits != FineEdits::ColourAndPosition {
+        fields.push(("fine_edits", string(mesh.fine_edits.name())));
+    }
+    let edits: Vec<String> = mesh.edits.iter().map(write_edit).collect();
+    if !edits.is_empty() {
+        fields.push(("edits", block_array(indent + 2, edits)));
+    }
     block_object(indent, &fields)
+}
+
+fn write_edit(e: &Edit) -> String {
+    let a = e.address;
+    let mut f = vec![
+        ("level", a.level.to_string()),
+        ("face", a.face.to_string()),
+        ("point", a.point.to_string()),
+        ("at", indices(&a.at)),
+    ];
+    match e.colour {
+        Some(ColourEdit::Set(c)) => f.push(("colour", numbers(&c))),
+        Some(ColourEdit::Offset(d)) => f.push(("colour_offset", numbers(&d))),
+        None => {}
+    }
+    match e.opacity {
+        Some(OpacityEdit::Set(o)) => f.push(("opacity", num(o))),
+        Some(OpacityEdit::Offset(d)) => f.push(("opacity_offset", num(d))),
+        None => {}
+    }
+    if let Some(o) = e.offset {
+        f.push(("offset", numbers(&[o.x, o.y])));
+    }
+    inline_object(&f)
 }
 
 /// One layer of a refined mesh, for [`write_refined`].

@@ -310,12 +310,15 @@ fn choose_level(
         while data.levels.len() <= k {
             let j = data.levels.len() - 1;
             refinement.extend_to(j + 1);
-            let next = refinement.stencils(j).apply(&data.levels[j]);
+            let next = refinement.next_level_data(j, &data.levels[j]);
             data.levels.push(next);
         }
     };
     if let Some(forced) = opts.level {
-        let k = forced.max(2);
+        // Edits of level d show fully from level d + 1.
+        let k = forced
+            .max(2)
+            .max(refinement.base().edits.deepest_level() + 1);
         extend(refinement, data, k);
         let lim = limit_of(refinement, data, k);
         let choice = Choice {
@@ -327,7 +330,16 @@ fn choose_level(
         return (choice, lim);
     }
     let passes = |m: &Measure| m.extent <= quad && m.colour <= colour_tol && m.outline <= tol;
+    // Edits of level k show fully from level k + 1 (their rings are set there).
+    let wanted = refinement.base().edits.deepest_level() + 1;
     let mut k = 2;
+    while k < wanted
+        && refinement.topology(k).corner_count() <= opts.max_quads
+        && k < opts.max_level.max(2)
+    {
+        k += 1;
+        extend(refinement, data, k);
+    }
     let mut lim = limit_of(refinement, data, k);
     let mut last: Option<Measure> = None;
     loop {
@@ -396,8 +408,11 @@ pub(crate) fn prepare(
         return Ok((LayerInfo::default(), None, Vec::new()));
     }
     let space = opts.colour_space_override.unwrap_or(mesh.colour_space);
+    let original_space = mesh.colour_space;
     let mesh = in_space(mesh, space);
     let (mut refinement, warnings) = Refinement::new(&mesh, 2).map_err(|e| e.in_layer(index))?;
+    // The edits' colours stay in the space they were written in.
+    refinement.set_edit_colour_space(original_space);
     let warnings = warnings
         .into_iter()
         .map(|w| Warning {
