@@ -648,22 +648,34 @@ fn locate<'e>(
     out
 }
 
-/// The vertices of level `t` at the same position as boundary vertex `v` (its copies across
-/// discontinuous edges), `v` excluded.
-fn copies(t: &Topology, data: &[VertexData], v: u32) -> Vec<u32> {
-    if !t.is_boundary_vertex(v as usize) {
-        return Vec::new();
+/// The boundary vertices of a level sorted by x, to find the copies of a vertex across
+/// discontinuous edges (the same position, another vertex) without a scan per edit.
+struct BoundaryIndex {
+    by_x: Vec<(f64, u32)>,
+}
+
+impl BoundaryIndex {
+    fn new(t: &Topology, data: &[VertexData]) -> Self {
+        let mut by_x: Vec<(f64, u32)> = (0..t.vertex_count() as u32)
+            .filter(|&w| t.is_boundary_vertex(w as usize))
+            .map(|w| (data[w as usize][0], w))
+            .collect();
+        by_x.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        BoundaryIndex { by_x }
     }
-    let p = data[v as usize];
-    let tol = 1e-12 * (1.0 + p[0].abs().max(p[1].abs()));
-    (0..t.vertex_count() as u32)
-        .filter(|&w| {
-            w != v
-                && t.is_boundary_vertex(w as usize)
-                && (data[w as usize][0] - p[0]).abs() <= tol
-                && (data[w as usize][1] - p[1]).abs() <= tol
-        })
-        .collect()
+
+    /// The other boundary vertices at the position of `v`.
+    fn copies(&self, data: &[VertexData], v: u32) -> Vec<u32> {
+        let p = data[v as usize];
+        let tol = 1e-12 * (1.0 + p[0].abs().max(p[1].abs()));
+        let start = self.by_x.partition_point(|&(x, _)| x < p[0] - tol);
+        self.by_x[start..]
+            .iter()
+            .take_while(|&&(x, _)| x <= p[0] + tol)
+            .map(|&(_, w)| w)
+            .filter(|&w| w != v && (data[w as usize][1] - p[1]).abs() <= tol)
+            .collect()
+    }
 }
 
 /// Applies the edits of `level` to its data, after flattening the rings of the previous level's
@@ -694,6 +706,7 @@ pub(crate) fn apply(
     // Every change is computed from the data as subdivision left it, then written.
     let mut writes: Vec<(u32, VertexData)> = Vec::with_capacity(located.len());
     let mut moves: Vec<(u32, Vec2)> = Vec::new();
+    let mut boundary: Option<BoundaryIndex> = None;
     for l in &located {
         let mut d = data[l.vertex as usize];
         let old = d;
@@ -727,8 +740,11 @@ pub(crate) fn apply(
             };
             let delta = edge(pi) * off.x + edge(pj) * off.y;
             moves.push((l.vertex, delta));
-            for w in copies(t, data, l.vertex) {
-                moves.push((w, delta));
+            if t.is_boundary_vertex(l.vertex as usize) {
+                let index = boundary.get_or_insert_with(|| BoundaryIndex::new(t, data));
+                for w in index.copies(data, l.vertex) {
+                    moves.push((w, delta));
+                }
             }
         }
         writes.push((l.vertex, d));

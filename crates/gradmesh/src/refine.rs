@@ -48,7 +48,8 @@ impl Refinement {
 
     /// As [`Refinement::new`], but first refuses a mesh beyond `limits` (points, faces,
     /// corners) and a refinement whose deepest level would exceed them (level, faces, 32-bit
-    /// indices), estimated before anything is built ([`Limits::check_refinement`]).
+    /// indices), estimated before anything is built ([`Limits::check_refinement`]). The level
+    /// below the deepest edit counts too: limits and renderings refine that far.
     pub fn new_with_limits(
         mesh: &GradientMesh,
         depth: usize,
@@ -57,6 +58,11 @@ impl Refinement {
         limits.check_mesh(mesh)?;
         let (base, warnings) = BaseMesh::new(mesh)?;
         limits.check_refinement(&base, depth)?;
+        // Limits below the deepest edit refine one level further than it.
+        let edited = base.edits.deepest_level();
+        if edited > 0 {
+            limits.check_refinement(&base, edited + 1)?;
+        }
         Ok((Refinement::from_base(base, depth), warnings))
     }
 

@@ -1,5 +1,7 @@
 //! Multi-resolution edits: addressing, exactness, locality, following coarse edits, round trips.
 
+mod common;
+
 use gradmesh::formats::json::{read_document, write_document};
 use gradmesh::render::{render_document, RenderOptions, View};
 use gradmesh::validate::VertexData;
@@ -8,6 +10,7 @@ use gradmesh::{
     Refinement, VertexAddress,
 };
 use kurbo::{Point, Vec2};
+use proptest::prelude::*;
 
 /// An `n` x `n` grid of squares of side `side`, colours from `colour(i, j)`.
 fn grid(n: u32, side: f64, colour: impl Fn(u32, u32) -> [f64; 3]) -> GradientMesh {
@@ -561,4 +564,127 @@ fn edit_syntax_errors_name_the_edit_and_the_line() {
     let bad = base.replacen("\"at\": [3, 3]", "\"at\": [3]", 1);
     let e = read_document(&bad).unwrap_err().to_string();
     assert!(e.contains("edit 0: at"), "{e}");
+}
+
+/// A random edit: which face, corner, level and place (as fractions, scaled to what exists),
+/// and what it changes.
+type RawEdit = (f64, f64, u32, f64, f64, u8, [f64; 3], f64);
+
+fn raw_edit() -> impl Strategy<Value = RawEdit> {
+    (
+        0.0f64..1.0,
+        0.0f64..1.0,
+        1u32..=3,
+        0.0f64..=1.0,
+        0.0f64..=1.0,
+        0u8..4,
+        (0.0f64..100.0, -80.0f64..80.0, -80.0f64..80.0).prop_map(|(a, b, c)| [a, b, c]),
+        0.0f64..1.0,
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 32, .. ProptestConfig::default() })]
+
+    /// Whatever the edits, every value of every level and of the limit is finite, opacity stays
+    /// in 0..1, and colours stay in the box of the colours in play (control colours and the
+    /// edited vertices' targets): a necessary condition of the hull property.
+    #[test]
+    fn random_edits_keep_colours_in_the_box_of_the_colours_in_play(
+        spec in common::mesh_spec(),
+        raw in prop::collection::vec(raw_edit(), 1..6),
+    ) {
+        let mut mesh = common::build(&spec);
+        for (f, c, level, i, j, kind, colour, amount) in raw {
+            let face = ((f * mesh.faces.len() as f64) as usize).min(mesh.faces.len() - 1);
+            let corners = &mesh.faces[face];
+            let point = corners[((c * corners.len() as f64) as usize).min(corners.len() - 1)];
+            let m = VertexAddress::sector_size(level) as f64;
+            let at = [(i * m).round() as u32, (j * m).round() as u32];
+            let mut edit = Edit::new(VertexAddress::new(level, face as u32, point, at));
+            match kind {
+                0 => edit.colour = Some(ColourEdit::Set(colour)),
+                1 => edit.colour = Some(ColourEdit::Offset([colour[0] - 50.0, colour[1], colour[2]])),
+                2 => edit.opacity = Some(OpacityEdit::Offset(amount - 0.5)),
+                _ => {
+                    edit.opacity = Some(OpacityEdit::Set(amount));
+                    edit.offset = Some(Vec2::new(amount - 0.5, 0.25));
+                }
+            }
+            mesh.set_edit(edit);
+        }
+        let (mut r, _) = match Refinement::new(&mesh, 4) {
+            Ok(x) => x,
+            Err(e) => {
+                // Two random addresses may name one vertex: the only refusal expected.
+                prop_assert!(e.to_string().contains("same vertex"), "{}", e);
+                return Ok(());
+            }
+        };
+        let data = r.evaluate();
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        let mut widen = |c: [f64; 3]| {
+            for k in 0..3 {
+                lo[k] = lo[k].min(c[k]);
+                hi[k] = hi[k].max(c[k]);
+            }
+        };
+        for p in &mesh.points {
+            widen(p.colour);
+        }
+        for i in 0..mesh.edits.len() {
+            let level = mesh.edits[i].address.level as usize;
+            let v = r.edited_vertex(i).expect("a checked edit names a vertex");
+            widen(colour_of(&data.levels[level][v]));
+        }
+        let mut all: Vec<VertexData> = data.levels.concat();
+        all.extend(r.limit(&data, 4));
+        for d in &all {
+            prop_assert!(d.iter().all(|x| x.is_finite()), "{:?}", d);
+            prop_assert!((-1e-12..=1.0 + 1e-12).contains(&d[5]), "opacity {}", d[5]);
+            for k in 0..3 {
+                let slack = 1e-9 * (1.0 + hi[k].abs().max(lo[k].abs()));
+                prop_assert!(d[2 + k] >= lo[k] - slack && d[2 + k] <= hi[k] + slack,
+                    "channel {} = {} outside [{}, {}]", k, d[2 + k], lo[k], hi[k]);
+            }
+        }
+    }
+}
+
+#[test]
+fn a_move_on_a_discontinuous_edge_moves_both_sides() {
+    let mut mesh = grid(2, 60.0, |i, j| {
+        [30.0 + 20.0 * i as f64, 10.0 * j as f64, 0.0]
+    });
+    mesh.set_edge(1, 4, gradmesh::EdgeKind::Discontinuous, None);
+    mesh.set_edge(4, 7, gradmesh::EdgeKind::Discontinuous, None);
+    // Face 0 = [0, 1, 4, 3] runs 4 -> 1 as the previous edge of its corner 4; face 1 =
+    // [1, 2, 5, 4] runs it as the next edge of its corner 4. The two names are two vertices.
+    let left = VertexAddress::new(2, 0, 4, [0, 2]);
+    let right = VertexAddress::new(2, 1, 4, [2, 0]);
+    let mut edited = mesh.clone();
+    edited.edits = vec![
+        Edit {
+            offset: Some(Vec2::new(0.5, 0.5)),
+            colour: Some(ColourEdit::Offset([0.0, 30.0, 0.0])),
+            ..Edit::new(left)
+        },
+        Edit::new(right),
+    ];
+    let (mut r, _) = Refinement::new(&edited, 3).unwrap();
+    let data = r.evaluate();
+    let (a, b) = (r.edited_vertex(0).unwrap(), r.edited_vertex(1).unwrap());
+    assert_ne!(a, b);
+    let (da, db) = (data.levels[2][a], data.levels[2][b]);
+    assert_eq!([da[0], da[1]], [db[0], db[1]], "both sides at one place");
+    let (plain, _) = Refinement::new(&mesh, 3).unwrap();
+    let p = plain.evaluate().levels[2][a];
+    assert!(
+        (p[0] - da[0]).abs() + (p[1] - da[1]).abs() > 1.0,
+        "it moved"
+    );
+    // Colour is per side: the other side keeps its own.
+    assert!((da[3] - p[3] - 30.0).abs() < 1e-9);
+    assert!((db[3] - plain.evaluate().levels[2][b][3]).abs() < 1e-12);
 }
