@@ -125,6 +125,16 @@ fn describe(mesh: &GradientMesh) -> Result<(String, Vec<gradmesh::Warning>), Err
         base.source_point.len() - mesh.points.len()
     )
     .unwrap();
+    if !mesh.edits.is_empty() {
+        writeln!(
+            s,
+            "    edits {}, down to level {}, {} (gradmesh edits lists them)",
+            mesh.edits.len(),
+            base.edits.deepest_level(),
+            mesh.fine_edits.name()
+        )
+        .unwrap();
+    }
     if let Some(b) = bounds(mesh) {
         writeln!(
             s,
