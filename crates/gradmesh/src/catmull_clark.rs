@@ -202,16 +202,8 @@ impl Stencils {
     /// table whatever the thread count.
     pub fn build(n: usize, terms: impl Fn(usize, &mut Vec<(u32, f64)>) + Sync) -> Stencils {
         use rayon::prelude::*;
-        const CHUNK: usize = 1 << 14;
-        let range = |r: std::ops::Range<usize>| {
-            let mut stencils = Stencils::with_capacity(r.len(), 10 * r.len());
-            let mut buffer = Vec::with_capacity(64);
-            for i in r {
-                terms(i, &mut buffer);
-                stencils.push(&mut buffer);
-            }
-            stencils
-        };
+        const CHUNK: usize = STENCIL_CHUNK;
+        let range = |r: std::ops::Range<usize>| build_range(r, &terms);
         if n <= CHUNK {
             return range(0..n);
         }
@@ -351,11 +343,68 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
         creasing: parent.creasing,
     };
 
-    // Stencils: face points, edge points, vertex points, each built in parallel by ranges.
-    let face_stencil = |f: usize, terms: &mut Vec<(u32, f64)>| {
+    let stencils = Stencils::build(nf + ne + nv, stencil_terms(parent));
+    (child, stencils)
+}
+
+/// The data of the child of `parent`: equal to `refine(parent).1.apply(data)`, bit for bit,
+/// but without building the child level or keeping the stencil table (each range of stencils
+/// is built, applied and dropped). For the last level of a refinement, when only its data is
+/// needed.
+pub fn refine_data(parent: &Level, data: &[VertexData]) -> Vec<VertexData> {
+    use rayon::prelude::*;
+    let t = &parent.topology;
+    let n = t.face_count() + t.edge_count() + t.vertex_count();
+    let terms = stencil_terms(parent);
+    let mut out = vec![[0.0; 6]; n];
+    out.par_chunks_mut(STENCIL_CHUNK)
+        .enumerate()
+        .for_each(|(k, chunk)| {
+            let first = k * STENCIL_CHUNK;
+            build_range(first..first + chunk.len(), &terms).apply_into(data, chunk);
+        });
+    out
+}
+
+/// Stencils built per task (and held at once per thread by [`refine_data`]).
+const STENCIL_CHUNK: usize = 1 << 14;
+
+/// The stencils `r` (numbered from 0 in the result) of the terms `terms(i, buffer)` pushes.
+fn build_range(
+    r: std::ops::Range<usize>,
+    terms: &(impl Fn(usize, &mut Vec<(u32, f64)>) + Sync),
+) -> Stencils {
+    let mut stencils = Stencils::with_capacity(r.len(), 10 * r.len());
+    let mut buffer = Vec::with_capacity(64);
+    for i in r {
+        terms(i, &mut buffer);
+        stencils.push(&mut buffer);
+    }
+    stencils
+}
+
+/// The terms of child vertex `i` of `parent`: face points, then edge points, then vertex
+/// points. Needs nothing of the child level: the child rule of a vertex point comes from the
+/// halves of its parent edges, which are its child edges in the same ring order.
+fn stencil_terms(parent: &Level) -> impl Fn(usize, &mut Vec<(u32, f64)>) + Sync + '_ {
+    let t = &parent.topology;
+    let (nf, ne) = (t.face_count(), t.edge_count());
+    // Only Chaikin creasing looks at the other edges around the vertex.
+    let half_sharpness = move |e: u32, v: u32| -> f64 {
+        let s = parent.edge_sharpness[e as usize];
+        match parent.creasing {
+            CreasingMethod::Uniform => rules::decrement_sharpness(s),
+            CreasingMethod::Chaikin => rules::child_edge_sharpness(
+                parent.creasing,
+                s,
+                &parent.incident_sharpness(v as usize),
+            ),
+        }
+    };
+    let face_stencil = move |f: usize, terms: &mut Vec<(u32, f64)>| {
         face_centroid_terms(t, f, 1.0, terms);
     };
-    let edge_stencil = |e: usize, terms: &mut Vec<(u32, f64)>| {
+    let edge_stencil = move |e: usize, terms: &mut Vec<(u32, f64)>| {
         let [a, b] = t.edge_vertices(e);
         let s = parent.edge_sharpness[e];
         let [f0, f1] = t.edge_faces(e);
@@ -375,10 +424,15 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
             face_centroid_terms(t, f1 as usize, 0.25 * smooth, terms);
         }
     };
-    let vertex_stencil = |v: usize, terms: &mut Vec<(u32, f64)>| {
-        let cv = vertex_point(v as u32) as usize;
+    let vertex_stencil = move |v: usize, terms: &mut Vec<(u32, f64)>| {
         let parent_rule = parent.vertex_rule(v);
-        let child_rule = child.vertex_rule(cv);
+        let child_vertex_sharpness = rules::decrement_sharpness(parent.vertex_sharpness[v]);
+        let child_sharp_count = t
+            .vertex_edges(v)
+            .iter()
+            .filter(|&&e| rules::is_sharp(half_sharpness(e, v as u32)))
+            .count();
+        let child_rule = rules::vertex_rule(child_vertex_sharpness, child_sharp_count);
         let parent_sharp =
             |k: usize| rules::is_sharp(parent.edge_sharpness[t.vertex_edges(v)[k] as usize]);
         if parent_rule == child_rule || parent_rule <= VertexRule::Dart {
@@ -394,7 +448,7 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
             let child_sharp = |k: usize| rules::is_sharp(child_incident[k]);
             let w = rules::fractional_weight(
                 parent.vertex_sharpness[v],
-                child.vertex_sharpness[cv],
+                child_vertex_sharpness,
                 &parent.incident_sharpness(v),
                 &child_incident,
             );
@@ -402,7 +456,7 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
             vertex_mask_terms(parent, v, child_rule, child_sharp, 1.0 - w, terms);
         }
     };
-    let stencils = Stencils::build(nf + ne + nv, |i, terms| {
+    move |i: usize, terms: &mut Vec<(u32, f64)>| {
         if i < nf {
             face_stencil(i, terms)
         } else if i < nf + ne {
@@ -410,8 +464,7 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
         } else {
             vertex_stencil(i - nf - ne, terms)
         }
-    });
-    (child, stencils)
+    }
 }
 
 #[cfg(test)]

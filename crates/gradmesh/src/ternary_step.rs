@@ -74,200 +74,215 @@ pub fn ternary_topology(t: &Topology) -> Topology {
         t.vertex_count(),
         t.corner_count(),
     );
-    let mut corner_face = vec![0u32; nc];
-    for f in 0..nf {
-        let o = t.face_offset(f);
-        corner_face[o..o + t.face_vertices(f).len()].fill(f as u32);
-    }
-    let face_range = |c: usize| {
-        let f = corner_face[c] as usize;
-        (f, t.face_offset(f), t.face_vertices(f).len())
-    };
-    let next = |c: usize| {
-        let (_, o, n) = face_range(c);
-        o + (c - o + 1) % n
-    };
-    let prev = |c: usize| {
-        let (_, o, n) = face_range(c);
-        o + (c - o + n - 1) % n
-    };
-    let corner_vertex = |c: usize| {
-        t.face_vertices(corner_face[c] as usize)[c - t.face_offset(corner_face[c] as usize)]
-    };
-    let corner_edge = |c: usize| {
-        t.face_edges(corner_face[c] as usize)[c - t.face_offset(corner_face[c] as usize)]
-    };
-    let end_at = |e: u32, v: u32| usize::from(t.edge_vertices(e as usize)[0] != v);
-
-    let ep = |e: u32, k: usize| (nv + 2 * e as usize + k) as u32;
+    let ep = |e: u32, k: u32| nv as u32 + 2 * e + k;
     let fp = |c: usize| (nv + 2 * ne + c) as u32;
-    let central = |f: usize| (f + 2 * t.face_offset(f)) as u32;
-    let quad = |c: usize| {
-        let (f, o, _) = face_range(c);
-        (f + o + 1 + c) as u32
-    };
-    let side = |c: usize| {
-        let (f, o, n) = face_range(c);
-        (f + o + 1 + n + c) as u32
-    };
-    let along = |e: u32, k: usize| 3 * e + k as u32;
+    let along = |e: u32, k: u32| 3 * e + k;
     let middle = |e: u32| 3 * e + 2;
     let out_spoke = |c: usize| (3 * ne + 3 * c) as u32;
     let in_spoke = |c: usize| (3 * ne + 3 * c + 1) as u32;
     let rim = |c: usize| (3 * ne + 3 * c + 2) as u32;
-    // Edge point of the outgoing and incoming edges at corner c, near c's vertex.
-    let ep_out = |c: usize| {
-        let e = corner_edge(c);
-        ep(e, end_at(e, corner_vertex(c)))
-    };
-    let ep_in = |c: usize| {
-        let e = corner_edge(prev(c));
-        ep(e, end_at(e, corner_vertex(c)))
-    };
 
-    let face_count = nf + 2 * nc;
-    let mut face_offsets = Vec::with_capacity(face_count + 1);
-    let mut face_verts = Vec::with_capacity(9 * nc);
-    let mut face_edges = Vec::with_capacity(9 * nc);
-    face_offsets.push(0u32);
+    // Per base corner, once: its face, neighbours, the ends of its two edges at its vertex,
+    // and its corner quad Q(c) and edge quad X(c). Plain array reads in the loops below.
+    let mut corner_face = vec![0u32; nc];
+    let mut next = vec![0u32; nc];
+    let mut prev = vec![0u32; nc];
+    let mut end_out = vec![0u32; nc];
+    let mut end_in = vec![0u32; nc];
+    let mut quad = vec![0u32; nc];
+    let mut side = vec![0u32; nc];
     for f in 0..nf {
-        let (o, n) = (t.face_offset(f), t.face_vertices(f).len());
-        for c in o..o + n {
-            face_verts.push(fp(c));
-            face_edges.push(rim(c));
-        }
-        face_offsets.push(face_verts.len() as u32);
-        for c in o..o + n {
-            let v = corner_vertex(c);
-            let (eo, ei) = (corner_edge(c), corner_edge(prev(c)));
-            face_verts.extend_from_slice(&[v, ep_out(c), fp(c), ep_in(c)]);
-            face_edges.extend_from_slice(&[
-                along(eo, end_at(eo, v)),
-                out_spoke(c),
-                in_spoke(c),
-                along(ei, end_at(ei, v)),
-            ]);
-            face_offsets.push(face_verts.len() as u32);
-        }
-        for c in o..o + n {
-            face_verts.extend_from_slice(&[ep_out(c), ep_in(next(c)), fp(next(c)), fp(c)]);
-            face_edges.extend_from_slice(&[
-                middle(corner_edge(c)),
-                in_spoke(next(c)),
-                rim(c),
-                out_spoke(c),
-            ]);
-            face_offsets.push(face_verts.len() as u32);
+        let (o, e) = (t.face_offsets[f] as usize, t.face_offsets[f + 1] as usize);
+        let n = e - o;
+        for c in o..e {
+            let (nx, pv) = (
+                if c + 1 == e { o } else { c + 1 },
+                if c == o { e - 1 } else { c - 1 },
+            );
+            let v = t.face_verts[c];
+            corner_face[c] = f as u32;
+            next[c] = nx as u32;
+            prev[c] = pv as u32;
+            end_out[c] = u32::from(t.edge_verts[t.face_edges[c] as usize][0] != v);
+            end_in[c] = u32::from(t.edge_verts[t.face_edges[pv] as usize][0] != v);
+            quad[c] = (f + o + 1 + c) as u32;
+            side[c] = (f + o + 1 + n + c) as u32;
         }
     }
+    let central = |f: usize| (f + 2 * t.face_offsets[f] as usize) as u32;
+    // Edge point of the outgoing and incoming edges at corner c, near c's vertex.
+    let ep_out = |c: usize| ep(t.face_edges[c], end_out[c]);
+    let ep_in = |c: usize| ep(t.face_edges[prev[c] as usize], end_in[c]);
+
+    // Faces, edges and rings are independent: built concurrently (each array by one task, in
+    // order, so the result does not depend on the thread count). Most of the cost is the first
+    // touch of fresh memory, which both cores can take.
+    let faces = || {
+        let face_count = nf + 2 * nc;
+        let mut face_offsets = Vec::with_capacity(face_count + 1);
+        let mut face_verts = Vec::with_capacity(9 * nc);
+        let mut face_edges = Vec::with_capacity(9 * nc);
+        face_offsets.push(0u32);
+        for f in 0..nf {
+            let (o, e) = (t.face_offsets[f] as usize, t.face_offsets[f + 1] as usize);
+            for c in o..e {
+                face_verts.push(fp(c));
+                face_edges.push(rim(c));
+            }
+            face_offsets.push(face_verts.len() as u32);
+            for c in o..e {
+                let (eo, ei) = (t.face_edges[c], t.face_edges[prev[c] as usize]);
+                face_verts.extend_from_slice(&[t.face_verts[c], ep_out(c), fp(c), ep_in(c)]);
+                face_edges.extend_from_slice(&[
+                    along(eo, end_out[c]),
+                    out_spoke(c),
+                    in_spoke(c),
+                    along(ei, end_in[c]),
+                ]);
+                face_offsets.push(face_verts.len() as u32);
+            }
+            for c in o..e {
+                let nx = next[c] as usize;
+                face_verts.extend_from_slice(&[ep_out(c), ep_in(nx), fp(nx), fp(c)]);
+                face_edges.extend_from_slice(&[
+                    middle(t.face_edges[c]),
+                    in_spoke(nx),
+                    rim(c),
+                    out_spoke(c),
+                ]);
+                face_offsets.push(face_verts.len() as u32);
+            }
+        }
+        (face_offsets, face_verts, face_edges)
+    };
 
     // The corner at which each base edge leaves its end 0 (first face) and end 1 (second face).
     let mut leaving = vec![[INVALID; 2]; ne];
     for c in 0..nc {
-        let e = corner_edge(c) as usize;
-        leaving[e][end_at(e as u32, corner_vertex(c))] = c as u32;
+        leaving[t.face_edges[c] as usize][end_out[c] as usize] = c as u32;
     }
-    let or_invalid =
-        |c: u32, f: &dyn Fn(usize) -> u32| if c == INVALID { INVALID } else { f(c as usize) };
+    let quad_of = |c: u32| quad[c as usize];
+    let side_of = |c: u32| side[c as usize];
+    let or_invalid = |c: u32, f: &dyn Fn(u32) -> u32| if c == INVALID { INVALID } else { f(c) };
 
-    let mut edge_verts = Vec::with_capacity(3 * ne + 3 * nc);
-    let mut edge_faces = Vec::with_capacity(3 * ne + 3 * nc);
-    for e in 0..ne as u32 {
-        let [a, b] = t.edge_vertices(e as usize);
-        let [c0, c1] = leaving[e as usize];
-        edge_verts.push([a, ep(e, 0)]);
-        edge_faces.push([quad(c0 as usize), or_invalid(c1, &|c| quad(next(c)))]);
-        edge_verts.push([ep(e, 1), b]);
-        edge_faces.push([quad(next(c0 as usize)), or_invalid(c1, &quad)]);
-        edge_verts.push([ep(e, 0), ep(e, 1)]);
-        edge_faces.push([side(c0 as usize), or_invalid(c1, &side)]);
-    }
-    for c in 0..nc {
-        edge_verts.push([ep_out(c), fp(c)]);
-        edge_faces.push([quad(c), side(c)]);
-        edge_verts.push([ep_in(c), fp(c)]);
-        edge_faces.push([side(prev(c)), quad(c)]);
-        edge_verts.push([fp(c), fp(next(c))]);
-        edge_faces.push([central(corner_face[c] as usize), side(c)]);
-    }
-
-    let vertex_count = nv + 2 * ne + nc;
-    let mut ring_offsets = Vec::with_capacity(vertex_count + 1);
-    let mut ring_faces = Vec::with_capacity(9 * 4 * nc);
-    let mut ring_corners = Vec::with_capacity(9 * 4 * nc);
-    let mut edge_ring_offsets = Vec::with_capacity(vertex_count + 1);
-    let mut ring_edges = Vec::with_capacity(9 * 4 * nc + vertex_count);
-    ring_offsets.push(0u32);
-    edge_ring_offsets.push(0u32);
-    let mut push_ring = |faces: &[(u32, u32)], edges: &[u32]| {
-        for &(f, c) in faces {
-            ring_faces.push(f);
-            ring_corners.push(c);
+    let edges = || {
+        let mut edge_verts = Vec::with_capacity(3 * ne + 3 * nc);
+        let mut edge_faces = Vec::with_capacity(3 * ne + 3 * nc);
+        for e in 0..ne as u32 {
+            let [a, b] = t.edge_verts[e as usize];
+            let [c0, c1] = leaving[e as usize];
+            edge_verts.push([a, ep(e, 0)]);
+            edge_faces.push([quad_of(c0), or_invalid(c1, &|c| quad_of(next[c as usize]))]);
+            edge_verts.push([ep(e, 1), b]);
+            edge_faces.push([quad_of(next[c0 as usize]), or_invalid(c1, &quad_of)]);
+            edge_verts.push([ep(e, 0), ep(e, 1)]);
+            edge_faces.push([side_of(c0), or_invalid(c1, &side_of)]);
         }
-        ring_edges.extend_from_slice(edges);
-        ring_offsets.push(ring_faces.len() as u32);
-        edge_ring_offsets.push(ring_edges.len() as u32);
+        for c in 0..nc {
+            let (nx, pv) = (next[c] as usize, prev[c] as usize);
+            edge_verts.push([ep_out(c), fp(c)]);
+            edge_faces.push([quad[c], side[c]]);
+            edge_verts.push([ep_in(c), fp(c)]);
+            edge_faces.push([side[pv], quad[c]]);
+            edge_verts.push([fp(c), fp(nx)]);
+            edge_faces.push([central(corner_face[c] as usize), side[c]]);
+        }
+        (edge_verts, edge_faces)
     };
-    // Vertex points: the base ring, mapped onto the corner quads.
-    let mut faces = Vec::new();
-    let mut edges = Vec::new();
-    for v in 0..nv {
-        faces.clear();
-        edges.clear();
-        for (&f, &c) in t.vertex_faces(v).iter().zip(t.vertex_face_corners(v)) {
-            faces.push((quad(t.face_offset(f as usize) + c as usize), 0));
+
+    // Every level-1 corner is in one ring; each ring has one more edge on a boundary.
+    let vertex_count = nv + 2 * ne + nc;
+    let rings = || {
+        let mut ring_offsets = Vec::with_capacity(vertex_count + 1);
+        let mut ring_faces = Vec::with_capacity(9 * nc);
+        let mut ring_corners = Vec::with_capacity(9 * nc);
+        let mut edge_ring_offsets = Vec::with_capacity(vertex_count + 1);
+        let mut ring_edges = Vec::with_capacity(9 * nc + vertex_count);
+        ring_offsets.push(0u32);
+        edge_ring_offsets.push(0u32);
+        // Vertex points: the base ring, mapped onto the corner quads.
+        for v in 0..nv {
+            let (r0, r1) = (t.ring_offsets[v] as usize, t.ring_offsets[v + 1] as usize);
+            for k in r0..r1 {
+                let f = t.ring_faces[k] as usize;
+                ring_faces.push(quad[t.face_offsets[f] as usize + t.ring_corners[k] as usize]);
+                ring_corners.push(0);
+            }
+            for &e in t.vertex_edges(v) {
+                ring_edges.push(along(e, u32::from(t.edge_verts[e as usize][0] != v as u32)));
+            }
+            ring_offsets.push(ring_faces.len() as u32);
+            edge_ring_offsets.push(ring_edges.len() as u32);
         }
-        for &e in t.vertex_edges(v) {
-            edges.push(along(e, end_at(e, v as u32)));
+        let mut push_ring = |faces: &[(u32, u32)], edges: &[u32]| {
+            for &(f, c) in faces {
+                ring_faces.push(f);
+                ring_corners.push(c);
+            }
+            ring_edges.extend_from_slice(edges);
+            ring_offsets.push(ring_faces.len() as u32);
+            edge_ring_offsets.push(ring_edges.len() as u32);
+        };
+        // Edge points, near end 0 then near end 1 of each base edge.
+        for e in 0..ne as u32 {
+            let [c0, c1] = leaving[e as usize].map(|c| c as usize);
+            let next0 = next[c0] as usize;
+            if leaving[e as usize][1] == INVALID {
+                push_ring(
+                    &[(quad[c0], 1), (side[c0], 0)],
+                    &[along(e, 0), out_spoke(c0), middle(e)],
+                );
+                push_ring(
+                    &[(side[c0], 1), (quad[next0], 3)],
+                    &[middle(e), in_spoke(next0), along(e, 1)],
+                );
+            } else {
+                let next1 = next[c1] as usize;
+                push_ring(
+                    &[
+                        (quad[c0], 1),
+                        (side[c0], 0),
+                        (side[c1], 1),
+                        (quad[next1], 3),
+                    ],
+                    &[along(e, 0), out_spoke(c0), middle(e), in_spoke(next1)],
+                );
+                push_ring(
+                    &[
+                        (quad[c1], 1),
+                        (side[c1], 0),
+                        (side[c0], 1),
+                        (quad[next0], 3),
+                    ],
+                    &[along(e, 1), out_spoke(c1), middle(e), in_spoke(next0)],
+                );
+            }
         }
-        push_ring(&faces, &edges);
-    }
-    // Edge points, near end 0 then near end 1 of each base edge.
-    for e in 0..ne as u32 {
-        let [c0, c1] = leaving[e as usize].map(|c| c as usize);
-        if leaving[e as usize][1] == INVALID {
-            push_ring(
-                &[(quad(c0), 1), (side(c0), 0)],
-                &[along(e, 0), out_spoke(c0), middle(e)],
-            );
-            push_ring(
-                &[(side(c0), 1), (quad(next(c0)), 3)],
-                &[middle(e), in_spoke(next(c0)), along(e, 1)],
-            );
-        } else {
+        // Face points.
+        for c in 0..nc {
+            let f = corner_face[c] as usize;
+            let pv = prev[c] as usize;
             push_ring(
                 &[
-                    (quad(c0), 1),
-                    (side(c0), 0),
-                    (side(c1), 1),
-                    (quad(next(c1)), 3),
+                    (quad[c], 2),
+                    (side[pv], 2),
+                    (central(f), c as u32 - t.face_offsets[f]),
+                    (side[c], 3),
                 ],
-                &[along(e, 0), out_spoke(c0), middle(e), in_spoke(next(c1))],
-            );
-            push_ring(
-                &[
-                    (quad(c1), 1),
-                    (side(c1), 0),
-                    (side(c0), 1),
-                    (quad(next(c0)), 3),
-                ],
-                &[along(e, 1), out_spoke(c1), middle(e), in_spoke(next(c0))],
+                &[out_spoke(c), in_spoke(c), rim(pv), rim(c)],
             );
         }
-    }
-    // Face points.
-    for c in 0..nc {
-        let (f, o, _) = face_range(c);
-        push_ring(
-            &[
-                (quad(c), 2),
-                (side(prev(c)), 2),
-                (central(f), (c - o) as u32),
-                (side(c), 3),
-            ],
-            &[out_spoke(c), in_spoke(c), rim(prev(c)), rim(c)],
-        );
-    }
+        (
+            ring_offsets,
+            ring_faces,
+            ring_corners,
+            edge_ring_offsets,
+            ring_edges,
+        )
+    };
+    let ((face_offsets, face_verts, face_edges), ((edge_verts, edge_faces), rings)) =
+        rayon::join(faces, || rayon::join(edges, rings));
+    let (ring_offsets, ring_faces, ring_corners, edge_ring_offsets, ring_edges) = rings;
 
     Topology {
         vertex_count,

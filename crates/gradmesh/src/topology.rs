@@ -43,6 +43,9 @@ impl Topology {
         is_cut: impl Fn(usize, usize) -> bool,
     ) -> Result<Topology, ErrorKind> {
         let face_count = face_offsets.len().saturating_sub(1);
+        // The last face (plus one) in which each vertex was seen: finds a repeated corner in
+        // linear time, and the same one as a scan of the earlier corners would.
+        let mut seen_in = vec![0u32; vertex_count];
         for f in 0..face_count {
             let corners = &face_verts[face_offsets[f] as usize..face_offsets[f + 1] as usize];
             for (i, &v) in corners.iter().enumerate() {
@@ -61,13 +64,14 @@ impl Topology {
                     reason: format!("has {} corners, at least 3 are needed", corners.len()),
                 });
             }
-            for (i, v) in corners.iter().enumerate() {
-                if corners[..i].contains(v) {
+            for &v in corners {
+                if seen_in[v as usize] == f as u32 + 1 {
                     return Err(ErrorKind::DegenerateFace {
                         face: f,
                         reason: format!("visits point {v} twice"),
                     });
                 }
+                seen_in[v as usize] = f as u32 + 1;
             }
         }
 
@@ -84,9 +88,14 @@ impl Topology {
                 prev_corner[h as usize] = if h == s { e - 1 } else { h - 1 };
             }
         }
-        let head = |h: usize| face_verts[next_corner[h] as usize];
+        // The vertex each half-edge runs to, read once (the keys below are taken many times).
+        let heads: Vec<u32> = next_corner
+            .iter()
+            .map(|&n| face_verts[n as usize])
+            .collect();
+        let head = |h: usize| heads[h];
         let key = |h: u32| {
-            let (a, b) = (face_verts[h as usize], head(h as usize));
+            let (a, b) = (face_verts[h as usize], heads[h as usize]);
             (a.min(b), a.max(b))
         };
         // Group half-edges by their undirected key: bucket by the smaller vertex (linear
@@ -411,98 +420,119 @@ impl Topology {
             leaving[e][side] = c as u32;
         }
 
-        let mut face_offsets = Vec::with_capacity(nc + 1);
-        let mut face_verts = Vec::with_capacity(4 * nc);
-        let mut face_edges = Vec::with_capacity(4 * nc);
-        for c in 0..nc {
-            face_offsets.push(4 * c as u32);
-            let (v, f) = (self.face_verts[c], corner_face[c] as usize);
-            let (out, inc) = (self.face_edges[c], self.face_edges[prev(c)]);
-            face_verts.extend_from_slice(&[vp(v), ep(out), fp(f), ep(inc)]);
-            face_edges.extend_from_slice(&[
-                half(out, end_at(out, v)),
-                inner(c),
-                inner(prev(c)),
-                half(inc, end_at(inc, v)),
-            ]);
-        }
-        face_offsets.push(4 * nc as u32);
+        // Faces, edges and rings are independent: built concurrently, each array by one task in
+        // order (the same result whatever the thread count); much of the cost is the first
+        // touch of fresh memory, which both cores can take.
+        let faces = || {
+            let mut face_offsets = Vec::with_capacity(nc + 1);
+            let mut face_verts = Vec::with_capacity(4 * nc);
+            let mut face_edges = Vec::with_capacity(4 * nc);
+            for c in 0..nc {
+                face_offsets.push(4 * c as u32);
+                let (v, f) = (self.face_verts[c], corner_face[c] as usize);
+                let (out, inc) = (self.face_edges[c], self.face_edges[prev(c)]);
+                face_verts.extend_from_slice(&[vp(v), ep(out), fp(f), ep(inc)]);
+                face_edges.extend_from_slice(&[
+                    half(out, end_at(out, v)),
+                    inner(c),
+                    inner(prev(c)),
+                    half(inc, end_at(inc, v)),
+                ]);
+            }
+            face_offsets.push(4 * nc as u32);
+            (face_offsets, face_verts, face_edges)
+        };
 
         let child_face = |c: u32| if c == INVALID { INVALID } else { c };
-        let mut edge_verts = Vec::with_capacity(2 * ne + nc);
-        let mut edge_faces = Vec::with_capacity(2 * ne + nc);
-        for e in 0..ne {
-            let [a, b] = self.edge_verts[e];
-            let [c0, c1] = leaving[e];
-            let after = |c: u32| {
-                if c == INVALID {
-                    INVALID
-                } else {
-                    next(c as usize) as u32
-                }
-            };
-            edge_verts.push([vp(a), ep(e as u32)]);
-            edge_faces.push([child_face(c0), after(c1)]);
-            edge_verts.push([ep(e as u32), vp(b)]);
-            edge_faces.push([after(c0), child_face(c1)]);
-        }
-        for c in 0..nc {
-            edge_verts.push([ep(self.face_edges[c]), fp(corner_face[c] as usize)]);
-            edge_faces.push([c as u32, next(c) as u32]);
-        }
+        let edges = || {
+            let mut edge_verts = Vec::with_capacity(2 * ne + nc);
+            let mut edge_faces = Vec::with_capacity(2 * ne + nc);
+            for e in 0..ne {
+                let [a, b] = self.edge_verts[e];
+                let [c0, c1] = leaving[e];
+                let after = |c: u32| {
+                    if c == INVALID {
+                        INVALID
+                    } else {
+                        next(c as usize) as u32
+                    }
+                };
+                edge_verts.push([vp(a), ep(e as u32)]);
+                edge_faces.push([child_face(c0), after(c1)]);
+                edge_verts.push([ep(e as u32), vp(b)]);
+                edge_faces.push([after(c0), child_face(c1)]);
+            }
+            for c in 0..nc {
+                edge_verts.push([ep(self.face_edges[c]), fp(corner_face[c] as usize)]);
+                edge_faces.push([c as u32, next(c) as u32]);
+            }
+            (edge_verts, edge_faces)
+        };
 
         let child_vertices = nf + ne + nv;
-        let mut ring_offsets = Vec::with_capacity(child_vertices + 1);
-        let mut ring_faces = Vec::with_capacity(4 * nc);
-        let mut ring_corners = Vec::with_capacity(4 * nc);
-        let mut edge_ring_offsets = Vec::with_capacity(child_vertices + 1);
-        let mut ring_edges = Vec::with_capacity(4 * nc + nv);
-        ring_offsets.push(0);
-        edge_ring_offsets.push(0);
-        let mut close = |ring_faces: &Vec<u32>, ring_edges: &Vec<u32>| {
-            ring_offsets.push(ring_faces.len() as u32);
-            edge_ring_offsets.push(ring_edges.len() as u32);
-        };
-        // Face points: round the face backwards.
-        for f in 0..nf {
-            let (o, n) = (self.face_offsets[f] as usize, self.face_vertices(f).len());
-            for k in 0..n {
-                let c = o + (n - k) % n;
-                ring_faces.push(c as u32);
-                ring_corners.push(2);
-                ring_edges.push(inner(c));
+        let rings = || {
+            let mut ring_offsets = Vec::with_capacity(child_vertices + 1);
+            let mut ring_faces = Vec::with_capacity(4 * nc);
+            let mut ring_corners = Vec::with_capacity(4 * nc);
+            let mut edge_ring_offsets = Vec::with_capacity(child_vertices + 1);
+            let mut ring_edges = Vec::with_capacity(4 * nc + nv);
+            ring_offsets.push(0);
+            edge_ring_offsets.push(0);
+            let mut close = |ring_faces: &Vec<u32>, ring_edges: &Vec<u32>| {
+                ring_offsets.push(ring_faces.len() as u32);
+                edge_ring_offsets.push(ring_edges.len() as u32);
+            };
+            // Face points: round the face backwards.
+            for f in 0..nf {
+                let (o, n) = (self.face_offsets[f] as usize, self.face_vertices(f).len());
+                for k in 0..n {
+                    let c = o + (n - k) % n;
+                    ring_faces.push(c as u32);
+                    ring_corners.push(2);
+                    ring_edges.push(inner(c));
+                }
+                close(&ring_faces, &ring_edges);
             }
-            close(&ring_faces, &ring_edges);
-        }
-        // Edge points: two faces on each side of the edge.
-        for e in 0..ne {
-            let [c0, c1] = leaving[e];
-            let c0n = next(c0 as usize) as u32;
-            ring_faces.extend_from_slice(&[c0, c0n]);
-            ring_corners.extend_from_slice(&[1, 3]);
-            ring_edges.extend_from_slice(&[
-                half(e as u32, 0),
-                inner(c0 as usize),
-                half(e as u32, 1),
-            ]);
-            if c1 != INVALID {
-                ring_faces.extend_from_slice(&[c1, next(c1 as usize) as u32]);
+            // Edge points: two faces on each side of the edge.
+            for e in 0..ne {
+                let [c0, c1] = leaving[e];
+                let c0n = next(c0 as usize) as u32;
+                ring_faces.extend_from_slice(&[c0, c0n]);
                 ring_corners.extend_from_slice(&[1, 3]);
-                ring_edges.push(inner(c1 as usize));
+                ring_edges.extend_from_slice(&[
+                    half(e as u32, 0),
+                    inner(c0 as usize),
+                    half(e as u32, 1),
+                ]);
+                if c1 != INVALID {
+                    ring_faces.extend_from_slice(&[c1, next(c1 as usize) as u32]);
+                    ring_corners.extend_from_slice(&[1, 3]);
+                    ring_edges.push(inner(c1 as usize));
+                }
+                close(&ring_faces, &ring_edges);
             }
-            close(&ring_faces, &ring_edges);
-        }
-        // Vertex points: the parent ring, mapped.
-        for v in 0..nv {
-            for (&f, &c) in self.vertex_faces(v).iter().zip(self.vertex_face_corners(v)) {
-                ring_faces.push(self.face_offsets[f as usize] + c);
-                ring_corners.push(0);
+            // Vertex points: the parent ring, mapped.
+            for v in 0..nv {
+                for (&f, &c) in self.vertex_faces(v).iter().zip(self.vertex_face_corners(v)) {
+                    ring_faces.push(self.face_offsets[f as usize] + c);
+                    ring_corners.push(0);
+                }
+                for &e in self.vertex_edges(v) {
+                    ring_edges.push(half(e, end_at(e, v as u32)));
+                }
+                close(&ring_faces, &ring_edges);
             }
-            for &e in self.vertex_edges(v) {
-                ring_edges.push(half(e, end_at(e, v as u32)));
-            }
-            close(&ring_faces, &ring_edges);
-        }
+            (
+                ring_offsets,
+                ring_faces,
+                ring_corners,
+                edge_ring_offsets,
+                ring_edges,
+            )
+        };
+        let ((face_offsets, face_verts, face_edges), ((edge_verts, edge_faces), rings)) =
+            rayon::join(faces, || rayon::join(edges, rings));
+        let (ring_offsets, ring_faces, ring_corners, edge_ring_offsets, ring_edges) = rings;
 
         Topology {
             vertex_count: child_vertices,

@@ -98,12 +98,16 @@ impl BaseMesh {
         let n = mesh.points.len();
 
         // The user's topology, whole: it must be manifold before any cut.
-        let whole = Topology::from_faces(n, &mesh.faces)?;
-        let mut edge_index: HashMap<(u32, u32), usize> = HashMap::with_capacity(whole.edge_count());
-        for e in 0..whole.edge_count() {
-            let [a, b] = whole.edge_vertices(e);
-            edge_index.insert(edge_key(a, b), e);
-        }
+        let (offsets, flat_corners) = flatten(&mesh.faces);
+        let whole = Topology::build(n, offsets.clone(), flat_corners.clone(), |_, _| false)?;
+        // Whether points a and b are joined by an edge: a scan of a's ring (no hash table).
+        let has_edge = |a: u32, b: u32| {
+            (a as usize) < n
+                && whole
+                    .vertex_edges(a as usize)
+                    .iter()
+                    .any(|&e| whole.other_vertex(e as usize, a) == b)
+        };
         for e in 0..whole.edge_count() {
             let [a, b] = whole.edge_vertices(e);
             let (p, q) = (
@@ -119,7 +123,13 @@ impl BaseMesh {
                 }
                 .into());
             }
-            let len = (q.x - p.x).hypot(q.y - p.y);
+            // hypot is at least the larger component: only tiny edges need it.
+            let (dx, dy) = ((q.x - p.x).abs(), (q.y - p.y).abs());
+            let len = if dx.max(dy) >= MIN_EDGE_LENGTH {
+                dx.max(dy)
+            } else {
+                dx.hypot(dy)
+            };
             if len < MIN_EDGE_LENGTH {
                 return Err(invalid(
                     format!("edge {}-{}", a.min(b), a.max(b)),
@@ -128,7 +138,7 @@ impl BaseMesh {
             }
         }
         for &(a, b) in mesh.edges.keys() {
-            if !edge_index.contains_key(&(a, b)) {
+            if !has_edge(a, b) {
                 return Err(ErrorKind::NoSuchEdge {
                     what: "edge tag".into(),
                     a,
@@ -138,7 +148,7 @@ impl BaseMesh {
             }
         }
         for (&(from, to), h) in &mesh.handles {
-            if !edge_index.contains_key(&edge_key(from, to)) {
+            if !has_edge(from, to) {
                 return Err(ErrorKind::NoSuchEdge {
                     what: format!("handle of point {from}"),
                     a: from,
@@ -160,19 +170,27 @@ impl BaseMesh {
             }
         }
 
+        // Without discontinuous edges no point is split: the whole topology is the base level.
+        let any_discontinuous = mesh
+            .edges
+            .values()
+            .any(|t| t.kind == EdgeKind::Discontinuous);
         let is_discontinuous = |a: u32, b: u32| {
-            mesh.edges
-                .get(&edge_key(a, b))
-                .is_some_and(|t| t.kind == EdgeKind::Discontinuous)
+            any_discontinuous
+                && mesh
+                    .edges
+                    .get(&edge_key(a, b))
+                    .is_some_and(|t| t.kind == EdgeKind::Discontinuous)
         };
 
         // Wedges: split each point's fan at discontinuous interior edges.
         // wedge_of_corner[corner] = split vertex index.
-        let mut corner_vertex: Vec<u32> = flatten(&mesh.faces).1;
+        let mut corner_vertex: Vec<u32> = flat_corners;
         let mut source_point: Vec<u32> = (0..n as u32).collect();
-        // (point, wedge's faces) for wedges beyond the first, to find overrides.
-        let mut wedge_faces: Vec<Vec<u32>> = vec![Vec::new(); n];
-        for v in 0..n {
+        // The number of faces of each split vertex's wedge, to tell whole points from wedges.
+        let mut wedge_face_count: Vec<u32> =
+            (0..n).map(|v| whole.vertex_faces(v).len() as u32).collect();
+        for v in (0..n).filter(|_| any_discontinuous) {
             let faces = whole.vertex_faces(v);
             let corners = whole.vertex_face_corners(v);
             let edges = whole.vertex_edges(v);
@@ -206,16 +224,20 @@ impl BaseMesh {
                     };
                 }
             }
+            if wedge_count == 1 {
+                continue;
+            }
             let mut ids = vec![v as u32];
+            wedge_face_count[v] = 0;
             for _ in 1..wedge_count {
                 ids.push(source_point.len() as u32);
                 source_point.push(v as u32);
-                wedge_faces.push(Vec::new());
+                wedge_face_count.push(0);
             }
             for (k, &f) in faces.iter().enumerate() {
                 let id = ids[wedge_of_face[k]];
                 corner_vertex[whole.face_offset(f as usize) + corners[k] as usize] = id;
-                wedge_faces[id as usize].push(f);
+                wedge_face_count[id as usize] += 1;
             }
         }
 
@@ -272,7 +294,7 @@ impl BaseMesh {
                 d[5] = o;
             }
             for (&to, &h) in &w.handles {
-                if !edge_index.contains_key(&edge_key(w.point, to)) {
+                if !has_edge(w.point, to) {
                     return Err(ErrorKind::NoSuchEdge {
                         what: format!("handle of {what}"),
                         a: w.point,
@@ -287,7 +309,7 @@ impl BaseMesh {
                 )?;
             }
             override_handles[id] = Some(&w.handles);
-            if wedge_faces[id].len() == whole.vertex_faces(w.point as usize).len() {
+            if wedge_face_count[id] as usize == whole.vertex_faces(w.point as usize).len() {
                 warn(
                     &mut warnings,
                     format!("{what}: the point is on no discontinuous edge, so the entry recolours it on every side"),
@@ -295,13 +317,19 @@ impl BaseMesh {
             }
         }
 
+        let unused: Vec<usize> = (0..n)
+            .filter(|&v| whole.vertex_faces(v).is_empty())
+            .collect();
         // The split topology: discontinuous edges are cut into two boundaries.
-        let offsets = flatten(&mesh.faces).0;
-        let topology = Topology::build(split_count, offsets, corner_vertex, |f, c| {
-            let face = &mesh.faces[f];
-            is_discontinuous(face[c], face[(c + 1) % face.len()])
-        })
-        .map_err(Error::from)?;
+        let topology = if any_discontinuous {
+            Topology::build(split_count, offsets, corner_vertex, |f, c| {
+                let face = &mesh.faces[f];
+                is_discontinuous(face[c], face[(c + 1) % face.len()])
+            })
+            .map_err(Error::from)?
+        } else {
+            whole
+        };
 
         let mut edge_handles = Vec::with_capacity(topology.edge_count());
         let mut edge_sharpness = Vec::with_capacity(topology.edge_count());
@@ -328,10 +356,8 @@ impl BaseMesh {
             })
             .collect();
 
-        for v in 0..n {
-            if whole.vertex_faces(v).is_empty() {
-                warn(&mut warnings, format!("point {v} is not used by any face"));
-            }
+        for v in unused {
+            warn(&mut warnings, format!("point {v} is not used by any face"));
         }
         for (v, p) in mesh.points.iter().enumerate() {
             if !mesh.colour_space.in_srgb_gamut(p.colour) {

@@ -1,8 +1,11 @@
 //! `gradmesh refine`: the refined control mesh, or its limit points, at a level.
 
+use gradmesh::catmull_clark::{self, Level};
 use gradmesh::formats::{self, Format};
 use gradmesh::refine::Refinement;
-use gradmesh::{Error, ErrorKind};
+use gradmesh::validate::{BaseMesh, VertexData};
+use gradmesh::{binary_step, ternary_step};
+use gradmesh::{Error, ErrorKind, FirstStep, GradientMesh, Limits, Topology};
 
 use crate::args::RefineArgs;
 
@@ -28,6 +31,13 @@ pub fn run(args: &RefineArgs) -> Result<(), Error> {
     let mut layers = Vec::with_capacity(doc.layers.len());
     for (i, mesh) in doc.layers.iter().enumerate() {
         let locate = |e: Error| e.in_layer(i).in_file(&args.input);
+        if !args.limit && !mesh.interpolate_positions && args.levels >= 1 {
+            // Only the last level is written: keep one level at a time.
+            let (topology, points) =
+                last_level(mesh, args.levels, &limits, &args.input).map_err(locate)?;
+            layers.push((Refined::Last(Box::new(topology)), points));
+            continue;
+        }
         let (mut refinement, warnings) =
             Refinement::new_with_limits(mesh, args.levels, &limits).map_err(locate)?;
         if args.limit {
@@ -53,7 +63,7 @@ pub fn run(args: &RefineArgs) -> Result<(), Error> {
             std::mem::take(&mut data.levels[args.levels])
         };
         drop(data);
-        layers.push((refinement, points));
+        layers.push((Refined::All(Box::new(refinement)), points));
     }
     match format {
         Format::Obj => {
@@ -91,4 +101,56 @@ pub fn run(args: &RefineArgs) -> Result<(), Error> {
             )
         }
     }
+}
+
+/// The refined topology of one layer: every level, or only the last one.
+enum Refined {
+    All(Box<Refinement>),
+    Last(Box<Topology>),
+}
+
+impl Refined {
+    fn topology(&self, level: usize) -> &Topology {
+        match self {
+            Refined::All(r) => r.topology(level),
+            Refined::Last(t) => t,
+        }
+    }
+}
+
+/// Level `levels >= 1` of `mesh` (topology and data), as [`Refinement::new_with_limits`] and
+/// [`Refinement::evaluate`] compute it for a mesh without interpolated positions, but holding
+/// at most two levels at a time and never the last step's stencils.
+fn last_level(
+    mesh: &GradientMesh,
+    levels: usize,
+    limits: &Limits,
+    input: &std::path::Path,
+) -> Result<(Topology, Vec<VertexData>), Error> {
+    limits.check_mesh(mesh)?;
+    let (base, warnings) = BaseMesh::new(mesh)?;
+    limits.check_refinement(&base, levels)?;
+    super::print_warnings(input, &warnings);
+    let (mut level, mut data): (Level, _) = match base.first_step {
+        FirstStep::Ternary => (
+            ternary_step::ternary_level(&base),
+            ternary_step::ternary_data(&base),
+        ),
+        FirstStep::Binary => (
+            binary_step::binary_level(&base),
+            binary_step::binary_data(&base),
+        ),
+    };
+    drop(base);
+    for _ in 2..levels {
+        let (child, stencils) = catmull_clark::refine(&level);
+        data = stencils.apply(&data);
+        level = child;
+    }
+    if levels >= 2 {
+        data = catmull_clark::refine_data(&level, &data);
+        let topology = level.topology.subdivide();
+        return Ok((topology, data));
+    }
+    Ok((level.topology, data))
 }

@@ -472,6 +472,7 @@ pub fn write_refined_obj_to(
     // Refined meshes reach millions of lines: format blocks of lines in parallel, with ryu for
     // the numbers (shortest round-trip form, like `{}` but several times faster).
     const BLOCK: usize = 1 << 14;
+    const GROUP: usize = 4 * BLOCK;
     w.write_all(
         b"# gradmesh refined mesh: v x y 0 c0 c1 c2 (colours in the mesh's working space)\n",
     )?;
@@ -484,8 +485,9 @@ pub fn write_refined_obj_to(
                 .collect();
             w.write_all(format!("o {clean}\n").as_bytes())?;
         }
-        // A bounded number of blocks at a time keeps memory small.
-        for group in data.chunks(BLOCK * 16) {
+        // A bounded number of blocks at a time keeps memory small (a group of text is about
+        // 4 MB: a few blocks per core).
+        for group in data.chunks(GROUP) {
             let vertices: Vec<String> = group
                 .par_chunks(BLOCK)
                 .map(|block| {
@@ -510,14 +512,18 @@ pub fn write_refined_obj_to(
                 w.write_all(s.as_bytes())?;
             }
         }
-        let face_ids: Vec<usize> = (0..topology.face_count()).collect();
-        for group in face_ids.chunks(BLOCK * 16) {
-            let faces: Vec<String> = group
-                .par_chunks(BLOCK)
-                .map(|block| {
+        let face_count = topology.face_count();
+        for group in (0..face_count).step_by(GROUP) {
+            let group_end = (group + GROUP).min(face_count);
+            let faces: Vec<String> = (group..group_end)
+                .step_by(BLOCK)
+                .collect::<Vec<_>>()
+                .into_par_iter()
+                .map(|first| {
+                    let block = first..(first + BLOCK).min(group_end);
                     let mut s = String::with_capacity(block.len() * 32);
                     let mut num = itoa::Buffer::new();
-                    for &f in block {
+                    for f in block {
                         s.push('f');
                         for &v in topology.face_vertices(f) {
                             s.push(' ');
