@@ -31,7 +31,8 @@ pub fn run(args: &RefineArgs) -> Result<(), Error> {
     let mut layers = Vec::with_capacity(doc.layers.len());
     for (i, mesh) in doc.layers.iter().enumerate() {
         let locate = |e: Error| e.in_layer(i).in_file(&args.input);
-        if !args.limit && !mesh.interpolate_positions && args.levels >= 1 {
+        // Edits apply between steps: such meshes take the full refinement.
+        if !args.limit && !mesh.interpolate_positions && mesh.edits.is_empty() && args.levels >= 1 {
             // Only the last level is written: keep one level at a time.
             let (topology, points) =
                 last_level(mesh, args.levels, &limits, &args.input).map_err(locate)?;
