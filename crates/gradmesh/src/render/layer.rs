@@ -1,6 +1,8 @@
 //! One layer made ready to draw: refinement level chosen, limit data tessellated into
 //! triangles, outline flattened, everything binned into bands of rows.
 
+use std::time::Instant;
+
 use rayon::prelude::*;
 
 use crate::colour::ColourSpace;
@@ -16,7 +18,7 @@ use super::nearest::{NearestSegments, Segment};
 use super::outline::{boundary_loops, outline};
 use super::triangles::{snap, Triangle, SUBPIXEL};
 use super::view::ToPixels;
-use super::{LayerInfo, RenderOptions};
+use super::{LayerInfo, LayerTimings, RenderOptions};
 
 /// Rows per band: the unit of parallel work.
 pub(crate) const BAND: usize = 16;
@@ -395,6 +397,8 @@ pub(crate) fn prepare(
     if mesh.faces.is_empty() {
         return Ok((LayerInfo::default(), None, Vec::new()));
     }
+    let mut timings = LayerTimings::default();
+    let start = Instant::now();
     let space = opts.colour_space_override.unwrap_or(mesh.colour_space);
     let mesh = in_space(mesh, space);
     let (mut refinement, warnings) = Refinement::new(&mesh, 2).map_err(|e| e.in_layer(index))?;
@@ -406,7 +410,11 @@ pub(crate) fn prepare(
         })
         .collect();
     let mut data = refinement.evaluate();
+    timings.refine = start.elapsed();
+    let start = Instant::now();
     let (choice, lim) = choose_level(&mut refinement, &mut data, xf, opts, space);
+    timings.evaluate = start.elapsed();
+    let start = Instant::now();
     let k = choice.level;
     let t = refinement.topology(k);
     let (w, h) = (opts.width as i64, opts.height as i64);
@@ -545,6 +553,10 @@ pub(crate) fn prepare(
         max_outline_deviation_px: choice.measured.map_or(f64::NAN, |m| m.outline),
         max_colour_error: choice.measured.map_or(f64::NAN, |m| m.colour),
         estimated: choice.estimated,
+        timings: LayerTimings {
+            tessellate: start.elapsed(),
+            ..timings
+        },
     };
     if lines.is_empty() || columns.0 >= columns.1 {
         return Ok((info, None, warnings));

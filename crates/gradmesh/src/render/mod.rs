@@ -67,6 +67,8 @@ mod overlay;
 mod triangles;
 mod view;
 
+use std::time::{Duration, Instant};
+
 use rayon::prelude::*;
 
 use crate::colour::{srgb_decode, ColourSpace};
@@ -266,6 +268,29 @@ pub struct LayerInfo {
     /// Whether the three figures above are estimated from the level above (halving per level,
     /// the outline's distance quartering) rather than measured at the level drawn.
     pub estimated: bool,
+    /// Time spent on each stage of preparing this layer.
+    pub timings: LayerTimings,
+}
+
+/// Wall-clock time of the stages that prepare one layer (layers are prepared in parallel, so
+/// these add up to more than [`RenderTimings::prepare`] when there are several).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LayerTimings {
+    /// Validation, the first step and the topology and data of the levels built.
+    pub refine: Duration,
+    /// Limit stencils or patch evaluation, and measuring the error to choose the density.
+    pub evaluate: Duration,
+    /// Triangles, outline and nearest-boundary table built and binned into bands.
+    pub tessellate: Duration,
+}
+
+/// Wall-clock time of the stages of a whole render.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RenderTimings {
+    /// Every layer prepared (see [`LayerTimings`] for the split per layer).
+    pub prepare: Duration,
+    /// Rasterisation, outline coverage, colour conversion and compositing, all bands.
+    pub draw: Duration,
 }
 
 /// What was drawn.
@@ -275,6 +300,8 @@ pub struct RenderInfo {
     pub layers: Vec<LayerInfo>,
     /// Warnings from validating the layers (legal but suspicious input).
     pub warnings: Vec<Warning>,
+    /// Time spent on each stage.
+    pub timings: RenderTimings,
 }
 
 /// Renders `doc` into a new `f32` image: straight alpha, sRGB-encoded colour.
@@ -320,6 +347,7 @@ pub fn render_document_into<P: OutputPixel>(
         .into());
     }
     let xf = ToPixels::new(&opts.view, opts.width, opts.height);
+    let start = Instant::now();
     let prepared: Vec<layer::Prepared> = doc
         .layers
         .par_iter()
@@ -333,6 +361,7 @@ pub fn render_document_into<P: OutputPixel>(
         info.warnings.extend(warnings);
         layers.extend(layer);
     }
+    info.timings.prepare = start.elapsed();
 
     let background = opts.background.map(|bg| {
         let a = bg[3].clamp(0.0, 1.0);
@@ -343,12 +372,14 @@ pub fn render_document_into<P: OutputPixel>(
         };
         [rgb[0] * a, rgb[1] * a, rgb[2] * a, a]
     });
+    let start = Instant::now();
     out.par_chunks_mut(4 * w * BAND).enumerate().for_each_init(
         || Scratch::new(w),
         |scratch, (band, chunk)| {
             draw_band(band, chunk, &layers, opts, background, scratch);
         },
     );
+    info.timings.draw = start.elapsed();
     Ok(info)
 }
 
