@@ -348,7 +348,11 @@ pub(super) fn tessellate(
     // vertex to its second), each vertex's from its first face.
     let edge_samples: Vec<Vec<VertexData>> = (0..t.edge_count())
         .map(|e| {
-            let owner = t.edge_faces(e)[0] as usize;
+            let owner = t
+                .edge_faces(e)
+                .into_iter()
+                .find(|&g| (g as usize) < nf)
+                .expect("an edge has a face") as usize;
             let k = t
                 .face_edges(owner)
                 .iter()

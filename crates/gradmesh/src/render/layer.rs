@@ -582,7 +582,8 @@ pub(crate) fn prepare(
     let bands = (opts.height as usize).div_ceil(BAND);
 
     let th = Thresholds::new(opts, space);
-    let fast = if opts.reference || opts.level.is_some() {
+    // The fast path starts at its base level: a shallower cap is the uniform path's to honour.
+    let fast = if opts.reference || opts.level.is_some() || opts.max_level < adaptive::BASE_LEVEL {
         None
     } else {
         adaptive::tessellate(&mut refinement, &mut data, xf, &th, opts.max_level, (w, h))

@@ -22,12 +22,14 @@
 //!      and the finer side collapses its extra boundary samples. Cells are drawn in the order
 //!      and with the diagonals of the quads uniform refinement would make (see `adaptive.rs`).
 //!      Faces whose control points all lie off the image are not refined.
-//!    - **Uniform path** (reference mode, [`RenderOptions::level`], or a layer the fast path
-//!      does not handle). The mesh is refined uniformly until every quad reaching the image
-//!      passes. Errors inside quads under a pixel across are not counted there: what survives
-//!      refinement that far sits at extraordinary and degenerate points (a handle of length
-//!      zero, say), where uniform refinement converges only linearly and would refine the whole
-//!      layer for a few pixels.
+//!    - **Uniform path** (reference mode, [`RenderOptions::level`], a
+//!      [`RenderOptions::max_level`] under 3, or a layer the fast path does not handle). The
+//!      mesh is refined uniformly until every quad reaching the image passes. Errors inside
+//!      quads under a pixel across are not counted there: what survives refinement that far
+//!      sits at extraordinary and degenerate points (a handle of length zero, say), where
+//!      uniform refinement converges only linearly and would refine the whole layer for a few
+//!      pixels. (The fast path counts them where the quad's box holds a pixel centre: only
+//!      that face goes deeper.)
 //!
 //!    The rendering notes' measurement (quads of about 3 px within 0.011 CIEDE2000 of quads of
 //!    0.7 px) says colour needs no more than a few pixels per quad; the tests measure the result
