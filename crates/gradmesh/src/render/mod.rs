@@ -267,12 +267,13 @@ impl RenderOptions {
 /// What was drawn for one layer.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct LayerInfo {
-    /// The refinement level drawn (0 for a layer without faces).
+    /// The refinement level drawn (0 for a layer without faces); on the fast path, the level
+    /// whose density the finest face has (faces each have their own).
     pub level: usize,
     /// Whether [`RenderOptions::max_level`] or [`RenderOptions::max_quads`] stopped the
     /// refinement before the quads met the size and tolerance asked for.
     pub capped: bool,
-    /// Quads at that level.
+    /// Quads at that level (on the fast path, the cells of all faces' grids).
     pub quads: usize,
     /// Triangles that reach the image.
     pub triangles: usize,
