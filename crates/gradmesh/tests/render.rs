@@ -228,46 +228,134 @@ fn control_colours_appear_at_their_limit_points() {
     }
 }
 
+/// The fast path against the reference rendering, at 16 bits: largest and mean CIEDE2000 over
+/// the interior pixels.
+fn compare_with_reference(name: &str, d: &Document, max_side: u32) -> (f64, f64) {
+    let mut opts = RenderOptions::fit(d, max_side);
+    let (fast, info) = render_image(d, &opts).unwrap();
+    opts.reference = true;
+    let (reference, ref_info) = render_image(d, &opts).unwrap();
+    save(&format!("fast-{name}"), &fast);
+    save(&format!("reference-{name}"), &reference);
+    // Compare at 16 bits.
+    let q = |img: &Image| {
+        let mut out = img.clone();
+        out.data = img.to_u16().iter().map(|&v| v as f32 / 65535.0).collect();
+        out
+    };
+    let (fast, reference) = (q(&fast), q(&reference));
+    let pixels = interior(&reference, 2);
+    assert!(
+        pixels.len() > 1000,
+        "{name}: {} interior pixels",
+        pixels.len()
+    );
+    let (mut max, mut sum) = (0.0f64, 0.0);
+    for &(x, y) in &pixels {
+        let e = delta_e(fast.pixel(x, y), reference.pixel(x, y));
+        max = max.max(e);
+        sum += e;
+    }
+    let mean = sum / pixels.len() as f64;
+    eprintln!(
+        "{name}: fast level {} vs reference level {}: max dE00 {max:.4}, mean {mean:.5} over {} pixels",
+        info.layers[0].level,
+        ref_info.layers[0].level,
+        pixels.len()
+    );
+    (max, mean)
+}
+
 /// The fast path against the reference rendering, at 16 bits.
 #[test]
 fn fast_path_matches_reference() {
     for (name, mesh) in test_meshes() {
-        let d = doc(vec![mesh]);
-        let mut opts = RenderOptions::fit(&d, 160);
-        let (fast, info) = render_image(&d, &opts).unwrap();
-        opts.reference = true;
-        let (reference, ref_info) = render_image(&d, &opts).unwrap();
-        save(&format!("fast-{name}"), &fast);
-        save(&format!("reference-{name}"), &reference);
-        // Compare at 16 bits.
-        let q = |img: &Image| {
-            let mut out = img.clone();
-            out.data = img.to_u16().iter().map(|&v| v as f32 / 65535.0).collect();
-            out
-        };
-        let (fast, reference) = (q(&fast), q(&reference));
-        let pixels = interior(&reference, 2);
-        assert!(
-            pixels.len() > 1000,
-            "{name}: {} interior pixels",
-            pixels.len()
-        );
-        let (mut max, mut sum) = (0.0f64, 0.0);
-        for &(x, y) in &pixels {
-            let e = delta_e(fast.pixel(x, y), reference.pixel(x, y));
-            max = max.max(e);
-            sum += e;
-        }
-        let mean = sum / pixels.len() as f64;
-        eprintln!(
-            "{name}: fast level {} vs reference level {}: max dE00 {max:.4}, mean {mean:.5} over {} pixels",
-            info.layers[0].level,
-            ref_info.layers[0].level,
-            pixels.len()
-        );
+        let (max, mean) = compare_with_reference(name, &doc(vec![mesh]), 160);
         assert!(max <= 0.5, "{name}: max dE00 {max}");
         assert!(mean <= 0.05, "{name}: mean dE00 {mean}");
     }
+}
+
+/// Meshes whose faces are not all regular B-spline patches: extraordinary vertices, corners,
+/// an infinitely sharp crease ending inside, a semi-sharp crease, a discontinuous edge.
+fn featured_meshes() -> Vec<(&'static str, GradientMesh)> {
+    let v = |i: u32, j: u32| j * 5 + i;
+    let mut creased = grid(4, 3, [0.0, 0.0, 400.0, 300.0], 0.2, soft_colour);
+    creased.set_edge(v(1, 1), v(2, 1), EdgeKind::Crease, None);
+    creased.set_edge(v(2, 1), v(3, 1), EdgeKind::Crease, None);
+    creased.set_edge(v(2, 2), v(2, 3), EdgeKind::Crease, Some(1.5));
+    let mut cut = grid(4, 3, [0.0, 0.0, 400.0, 300.0], -0.3, soft_colour);
+    cut.set_edge(v(2, 0), v(2, 1), EdgeKind::Discontinuous, None);
+    let mut star_crease = star(Point::new(0.0, 0.0), 100.0);
+    // A semi-sharp spoke from the extraordinary centre (point 0) to an inner point.
+    star_crease.set_edge(0, 1, EdgeKind::Crease, Some(2.0));
+    vec![
+        ("creased", creased),
+        ("cut", cut),
+        ("star-crease", star_crease),
+    ]
+}
+
+/// The adaptive fast path (regular patches evaluated directly, other faces refined locally,
+/// faces of different densities stitched) within the same tolerances of the reference mode
+/// (uniform refinement) on meshes with irregular features.
+#[test]
+fn adaptive_path_matches_reference_on_irregular_features() {
+    for (name, mesh) in featured_meshes() {
+        let (max, mean) = compare_with_reference(name, &doc(vec![mesh]), 200);
+        assert!(max <= 0.5, "{name}: max dE00 {max}");
+        assert!(mean <= 0.05, "{name}: mean dE00 {mean}");
+    }
+}
+
+/// No crack between faces of different densities: over an opaque background, every pixel whose
+/// square lies inside the mesh is exactly opaque, and every interior pixel is covered by a
+/// triangle, so its colour is close to the reference (a crack would show the colour of the
+/// nearest boundary point instead).
+#[test]
+fn adaptive_path_has_no_cracks() {
+    for (name, mesh) in featured_meshes().into_iter().chain(test_meshes()) {
+        let d = doc(vec![mesh]);
+        let mut opts = RenderOptions::fit(&d, 300);
+        opts.background = Some([0.0, 0.0, 0.0, 1.0]);
+        opts.dither = false;
+        let img = render_document(&d, &opts).unwrap();
+        opts.background = None;
+        let bare = render_document(&d, &opts).unwrap();
+        for (x, y) in interior(&bare, 2) {
+            assert_eq!(img.pixel(x, y)[3], 1.0, "{name}: ({x}, {y})");
+            assert_eq!(bare.pixel(x, y)[3], 1.0, "{name}: ({x}, {y})");
+        }
+    }
+}
+
+/// The default thread pool and a single thread give byte-identical images of real artwork,
+/// several layers, faces of many densities.
+#[test]
+fn deterministic_with_default_pool() {
+    let dir = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/realdata/gradientmeshimproved-off"
+    );
+    let mut layers = Vec::new();
+    for name in ["Tucan_Tucan_Layer3", "Tucan_Tucan_Layer1"] {
+        if let Ok(text) = std::fs::read_to_string(format!("{dir}/{name}.off")) {
+            layers.push(gradmesh::formats::off::read_off(&text).unwrap());
+        }
+    }
+    layers.extend(featured_meshes().into_iter().map(|(_, m)| m));
+    let d = doc(layers);
+    let opts = RenderOptions::fit(&d, 400);
+    let mut out_default = vec![0u8; 4 * opts.width as usize * opts.height as usize];
+    let mut out_single = out_default.clone();
+    gradmesh::render::render_document_into(&d, &opts, &mut out_default).unwrap();
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(|| gradmesh::render::render_document_into(&d, &opts, &mut out_single))
+        .unwrap();
+    assert!(out_default == out_single, "thread count changed the pixels");
 }
 
 /// Reference mode is converged: one more level changes no 16-bit channel by more than one step

@@ -115,14 +115,19 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
             opts.width,
             opts.height
         );
+        eprintln!("  prepare  {:9.2} ms", ms(info.timings.prepare));
+        eprintln!("  draw     {:9.2} ms", ms(info.timings.draw));
         eprintln!("encode     {:9.2} ms", ms(written));
         for (i, l) in info.layers.iter().enumerate() {
             eprintln!(
-                "layer {i}: level {}{}, {} quads, {} triangles drawn",
+                "layer {i}: level {}{}, {} quads, {} triangles drawn; refine {:.2} ms, evaluate {:.2} ms, tessellate {:.2} ms",
                 l.level,
                 if l.capped { " (capped)" } else { "" },
                 l.quads,
-                l.triangles
+                l.triangles,
+                ms(l.timings.refine),
+                ms(l.timings.evaluate),
+                ms(l.timings.tessellate),
             );
         }
     }

@@ -1,6 +1,8 @@
 //! One layer made ready to draw: refinement level chosen, limit data tessellated into
 //! triangles, outline flattened, everything binned into bands of rows.
 
+use std::time::Instant;
+
 use rayon::prelude::*;
 
 use crate::colour::ColourSpace;
@@ -11,12 +13,13 @@ use crate::refine::{RefinedMesh, Refinement};
 use crate::topology::Topology;
 use crate::validate::VertexData;
 
+use super::adaptive;
 use super::coverage::Line;
 use super::nearest::{NearestSegments, Segment};
 use super::outline::{boundary_loops, outline};
 use super::triangles::{snap, Triangle, SUBPIXEL};
 use super::view::ToPixels;
-use super::{LayerInfo, RenderOptions};
+use super::{LayerInfo, LayerTimings, RenderOptions};
 
 /// Rows per band: the unit of parallel work.
 pub(crate) const BAND: usize = 16;
@@ -31,6 +34,10 @@ const REFERENCE_COLOUR_TOLERANCE: f64 = 0.002;
 const REFERENCE_MIN_QUAD_PX: f64 = 0.1;
 /// Colour errors count in quads at least this wide (diagonal, pixels) in the fast path.
 const MIN_QUAD_PX: f64 = 1.0;
+/// The fast path holds each face's measured colour error to this fraction of the tolerance: the
+/// measure samples cell and side centres only, and each face now stops right at the threshold
+/// instead of at the level the worst spot of the layer asks for (the uniform path's margin).
+const ADAPTIVE_COLOUR_MARGIN: f64 = 0.5;
 /// Flattening tolerance of the outline (pixels): coverage error at most this per pixel.
 const OUTLINE_TOLERANCE_PX: f64 = 0.002;
 const REFERENCE_OUTLINE_TOLERANCE_PX: f64 = 0.0002;
@@ -110,16 +117,56 @@ struct Choice {
     estimated: bool,
 }
 
+/// What the fast path asks of the triangles (the reference mode has its own, stricter ones).
+pub(super) struct Thresholds {
+    /// Largest quad diagonal, pixels.
+    pub quad: f64,
+    /// Largest colour error.
+    pub colour: f64,
+    /// Largest outline distance, pixels.
+    pub outline: f64,
+    /// Colour errors count in quads at least this wide.
+    pub min_quad: f64,
+    /// Image size, pixels.
+    pub size: (f64, f64),
+    /// The working colour space.
+    pub space: ColourSpace,
+}
+
+impl Thresholds {
+    fn new(opts: &RenderOptions, space: ColourSpace) -> Thresholds {
+        Thresholds {
+            quad: opts.max_quad_px,
+            colour: ADAPTIVE_COLOUR_MARGIN * opts.colour_tolerance,
+            outline: opts.tolerance_px,
+            min_quad: MIN_QUAD_PX,
+            size: (opts.width as f64, opts.height as f64),
+            space,
+        }
+    }
+}
+
 /// How well the triangles of one level render the limit surface, over the quads that reach
 /// the image.
 #[derive(Clone, Copy, Debug, Default)]
-struct Measure {
+pub(super) struct Measure {
     /// Largest quad diagonal, pixels.
-    extent: f64,
+    pub extent: f64,
     /// Largest colour error, approximately CIE Lab units (opacity counts 100 per unit).
-    colour: f64,
+    pub colour: f64,
     /// Largest distance of the outline from the triangles' boundary edges, pixels.
-    outline: f64,
+    pub outline: f64,
+}
+
+impl Measure {
+    /// The largest of each figure (exact, so any grouping gives the same).
+    pub fn max(self, other: Measure) -> Measure {
+        Measure {
+            extent: self.extent.max(other.extent),
+            colour: self.colour.max(other.colour),
+            outline: self.outline.max(other.outline),
+        }
+    }
 }
 
 /// A colour difference in approximately CIE Lab units (Delta E 1976), opacity included.
@@ -202,67 +249,110 @@ fn measure(
     min_quad: f64,
 ) -> Measure {
     let nf = t.face_count();
-    let px = |d: &VertexData| xf.apply(d[0], d[1]);
-    let attr = |d: &VertexData| [d[2], d[3], d[4], d[5]];
-    let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
     // Per face, then the largest of each figure: max is exact, so any split gives the same.
     let face = |f: usize| -> Measure {
-        let mut m = Measure::default();
         let fv = t.face_vertices(f);
         if fv.len() != 4 {
-            return m;
+            return Measure::default();
         }
-        let p = [0, 1, 2, 3].map(|i| px(&lim[fv[i] as usize]));
-        let c = [0, 1, 2, 3].map(|i| attr(&lim[fv[i] as usize]));
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for q in &p {
-            for k in 0..2 {
-                lo[k] = lo[k].min(q[k]);
-                hi[k] = hi[k].max(q[k]);
-            }
-        }
-        if hi[0] < -1.0 || hi[1] < -1.0 || lo[0] > size.0 + 1.0 || lo[1] > size.1 + 1.0 {
-            return m;
-        }
-        let extent = dist(p[0], p[2]).max(dist(p[1], p[3]));
-        m.extent = m.extent.max(extent);
-        let tris = [[0, 1, 2], [0, 2, 3]];
-        let counts = extent >= min_quad;
-        let check = |m: &mut Measure, sample: &VertexData, tri: usize| {
-            if !counts {
-                return;
-            }
-            let shown = interpolate(tris[tri].map(|i| p[i]), tris[tri].map(|i| c[i]), px(sample));
-            m.colour = m.colour.max(colour_error(space, attr(sample), shown));
+        let fe = t.face_edges(f);
+        let corners = [0, 1, 2, 3].map(|i| &lim[fv[i] as usize]);
+        let mids = [0, 1, 2, 3].map(|k| &lim1[nf + fe[k] as usize]);
+        let boundary = [0, 1, 2, 3].map(|k| t.is_boundary_edge(fe[k] as usize));
+        let quad = QuadSamples {
+            corners,
+            centre: &lim1[f],
+            mids,
+            boundary,
         };
-        // The quad's centre lies on the shared diagonal: both triangles.
-        check(&mut m, &lim1[f], 0);
-        check(&mut m, &lim1[f], 1);
-        for (k, &e) in t.face_edges(f).iter().enumerate() {
-            let sample = &lim1[nf + e as usize];
-            check(&mut m, sample, if k < 2 { 0 } else { 1 });
-            if t.is_boundary_edge(e as usize) {
-                let (a, b) = (p[k], p[(k + 1) % 4]);
-                let x = px(sample);
-                let len = dist(a, b);
-                let off = if len > 0.0 {
-                    ((b[0] - a[0]) * (x[1] - a[1]) - (b[1] - a[1]) * (x[0] - a[0])).abs() / len
-                } else {
-                    dist(a, x)
-                };
-                m.outline = m.outline.max(off);
-            }
-        }
-        m
+        measure_quad(&quad, xf, size, space, min_quad, false)
     };
     (0..nf)
         .into_par_iter()
         .map(face)
-        .reduce(Measure::default, |a, b| Measure {
-            extent: a.extent.max(b.extent),
-            colour: a.colour.max(b.colour),
-            outline: a.outline.max(b.outline),
-        })
+        .reduce(Measure::default, Measure::max)
+}
+
+/// The samples of one quad that [`measure_quad`] needs: the limit data at its corners (wound),
+/// at its centre and at the midpoints of its sides (side `k` from corner `k` to `k + 1`), and
+/// which sides lie on the outline.
+pub(super) struct QuadSamples<'a> {
+    pub corners: [&'a VertexData; 4],
+    pub centre: &'a VertexData,
+    pub mids: [&'a VertexData; 4],
+    pub boundary: [bool; 4],
+}
+
+/// Measures one quad drawn as the triangles `(0, 1, 2)` and `(0, 2, 3)` (see [`measure`]).
+/// A quad entirely off the image counts for nothing. With `adaptive` (the fast path's faces,
+/// each with its own density), its centre and midpoints decide that too (a coarse quad may
+/// bulge into the image between its corners), and the colour error of a quad under
+/// `min_quad` still counts when the quad's box holds a pixel centre: such a quad is not
+/// refined along with larger ones elsewhere, as in a uniform level.
+pub(super) fn measure_quad(
+    q: &QuadSamples,
+    xf: &ToPixels,
+    size: (f64, f64),
+    space: ColourSpace,
+    min_quad: f64,
+    adaptive: bool,
+) -> Measure {
+    let px = |d: &VertexData| xf.apply(d[0], d[1]);
+    let attr = |d: &VertexData| [d[2], d[3], d[4], d[5]];
+    let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    let mut m = Measure::default();
+    let p = q.corners.map(px);
+    let c = q.corners.map(attr);
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    let mut grow = |x: [f64; 2]| {
+        for k in 0..2 {
+            lo[k] = lo[k].min(x[k]);
+            hi[k] = hi[k].max(x[k]);
+        }
+    };
+    p.iter().for_each(|&x| grow(x));
+    if adaptive {
+        grow(px(q.centre));
+        q.mids.iter().for_each(|&d| grow(px(d)));
+    }
+    if hi[0] < -1.0 || hi[1] < -1.0 || lo[0] > size.0 + 1.0 || lo[1] > size.1 + 1.0 {
+        return m;
+    }
+    let extent = dist(p[0], p[2]).max(dist(p[1], p[3]));
+    m.extent = m.extent.max(extent);
+    let tris = [[0, 1, 2], [0, 2, 3]];
+    let holds_centre = || {
+        let column = (lo[0] - 0.5).ceil() <= hi[0] - 0.5;
+        let row = (lo[1] - 0.5).ceil() <= hi[1] - 0.5;
+        column && row
+    };
+    let counts = extent >= min_quad || (adaptive && holds_centre());
+    let check = |m: &mut Measure, sample: &VertexData, tri: usize| {
+        if !counts {
+            return;
+        }
+        let shown = interpolate(tris[tri].map(|i| p[i]), tris[tri].map(|i| c[i]), px(sample));
+        m.colour = m.colour.max(colour_error(space, attr(sample), shown));
+    };
+    // The quad's centre lies on the shared diagonal: both triangles.
+    check(&mut m, q.centre, 0);
+    check(&mut m, q.centre, 1);
+    for k in 0..4 {
+        let sample = q.mids[k];
+        check(&mut m, sample, if k < 2 { 0 } else { 1 });
+        if q.boundary[k] {
+            let (a, b) = (p[k], p[(k + 1) % 4]);
+            let x = px(sample);
+            let len = dist(a, b);
+            let off = if len > 0.0 {
+                ((b[0] - a[0]) * (x[1] - a[1]) - (b[1] - a[1]) * (x[0] - a[0])).abs() / len
+            } else {
+                dist(a, x)
+            };
+            m.outline = m.outline.max(off);
+        }
+    }
+    m
 }
 
 /// The limit data of level `k >= 2` (all quads), without copying the level's data.
@@ -393,6 +483,84 @@ fn choose_level(
     }
 }
 
+/// The triangle through three points (pixels) with attributes `attr`, snapped, if it may
+/// cover a pixel centre of a `size` image.
+pub(super) fn screen_triangle_px(
+    exact: [[f64; 2]; 3],
+    attr: [[f64; 4]; 3],
+    size: (i64, i64),
+) -> Option<Triangle> {
+    let (w, h) = size;
+    let (xmax, ymax) = (w * SUBPIXEL, h * SUBPIXEL);
+    let snapped = |p: [f64; 2]| Some([snap(p[0])?, snap(p[1])?]);
+    let v = [snapped(exact[0])?, snapped(exact[1])?, snapped(exact[2])?];
+    let outside = v.iter().all(|p| p[0] < 0)
+        || v.iter().all(|p| p[0] > xmax)
+        || v.iter().all(|p| p[1] < 0)
+        || v.iter().all(|p| p[1] > ymax);
+    // No pixel centre column between the leftmost and rightmost vertex: nothing to draw
+    // (at deep levels most quads are under a pixel).
+    let half = SUBPIXEL / 2;
+    let left = v.iter().map(|p| p[0]).min().expect("three vertices");
+    let right = v.iter().map(|p| p[0]).max().expect("three vertices");
+    let no_column = (left - half).div_euclid(SUBPIXEL) == (right - half).div_euclid(SUBPIXEL)
+        && (left - half).rem_euclid(SUBPIXEL) != 0;
+    if outside || no_column {
+        return None;
+    }
+    let tri = Triangle::new(v, exact, attr)?;
+    (tri.rows.1 > 0 && tri.rows.0 < h && tri.rows.0 < tri.rows.1).then_some(tri)
+}
+
+/// The uniform path's triangles: every quad of level `t` with the limit data `lim` at its
+/// corners, in face order (the draw order where the surface folds over itself), and the
+/// boundary edges of that tessellation.
+fn uniform_triangles(
+    t: &Topology,
+    lim: &[VertexData],
+    xf: &ToPixels,
+    size: (i64, i64),
+) -> (Vec<Triangle>, Vec<Segment>) {
+    let exact: Vec<[f64; 2]> = lim.iter().map(|d| xf.apply(d[0], d[1])).collect();
+    let attr = |v: u32| {
+        let d = &lim[v as usize];
+        [d[2], d[3], d[4], d[5]]
+    };
+    let face_triangles = |f: usize| -> Vec<Triangle> {
+        let fv = t.face_vertices(f);
+        (1..fv.len() - 1)
+            .filter_map(|i| {
+                let idx = [fv[0], fv[i], fv[i + 1]];
+                screen_triangle_px(idx.map(|i| exact[i as usize]), idx.map(attr), size)
+            })
+            .collect()
+    };
+    // Built in parallel, collected in face order.
+    let triangles: Vec<Triangle> = (0..t.face_count())
+        .into_par_iter()
+        .flat_map_iter(face_triangles)
+        .collect();
+
+    // Boundary edges of the tessellation, for outline pixels no triangle reaches.
+    let snappable = |p: [f64; 2]| snap(p[0]).is_some() && snap(p[1]).is_some();
+    let mut segments = Vec::new();
+    for lp in &boundary_loops(t) {
+        for i in 0..lp.len() {
+            let (a, b) = (lp[i], lp[(i + 1) % lp.len()]);
+            if snappable(exact[a as usize]) && snappable(exact[b as usize]) {
+                let c = |v: u32| attr(v).map(|x| x as f32);
+                segments.push(Segment {
+                    a: exact[a as usize],
+                    b: exact[b as usize],
+                    ca: c(a),
+                    cb: c(b),
+                });
+            }
+        }
+    }
+    (triangles, segments)
+}
+
 /// What [`prepare`] returns: the layer's description, the layer ready to draw (`None` when
 /// nothing of it reaches the image) and the warnings of its validation.
 pub(crate) type Prepared = (LayerInfo, Option<PreparedLayer>, Vec<Warning>);
@@ -407,6 +575,8 @@ pub(crate) fn prepare(
     if mesh.faces.is_empty() {
         return Ok((LayerInfo::default(), None, Vec::new()));
     }
+    let mut timings = LayerTimings::default();
+    let start = Instant::now();
     let space = opts.colour_space_override.unwrap_or(mesh.colour_space);
     let original_space = mesh.colour_space;
     let mesh = in_space(mesh, space);
@@ -421,65 +591,55 @@ pub(crate) fn prepare(
         })
         .collect();
     let mut data = refinement.evaluate();
-    let (choice, lim) = choose_level(&mut refinement, &mut data, xf, opts, space);
-    let k = choice.level;
-    let t = refinement.topology(k);
+    timings.refine = start.elapsed();
+    let start = Instant::now();
     let (w, h) = (opts.width as i64, opts.height as i64);
     let bands = (opts.height as usize).div_ceil(BAND);
 
-    // Triangles, in face order (the draw order where the surface folds over itself).
-    let exact: Vec<[f64; 2]> = lim.iter().map(|d| xf.apply(d[0], d[1])).collect();
-    let pos: Vec<Option<[i64; 2]>> = exact
-        .iter()
-        .map(|p| Some([snap(p[0])?, snap(p[1])?]))
-        .collect();
-    let attr = |v: u32| {
-        let d = &lim[v as usize];
-        [d[2], d[3], d[4], d[5]]
+    let th = Thresholds::new(opts, space);
+    // The fast path starts at its base level: a shallower cap is the uniform path's to honour.
+    let fast = if opts.reference || opts.level.is_some() || opts.max_level < adaptive::BASE_LEVEL {
+        None
+    } else {
+        adaptive::tessellate(&mut refinement, &mut data, xf, &th, opts.max_level, (w, h))
     };
-    let (xmax, ymax) = (w * SUBPIXEL, h * SUBPIXEL);
-    let face_triangles = |f: usize| -> Vec<Triangle> {
-        let fv = t.face_vertices(f);
-        let mut out = Vec::with_capacity(fv.len() - 2);
-        for i in 1..fv.len() - 1 {
-            let idx = [fv[0], fv[i], fv[i + 1]];
-            let (Some(a), Some(b), Some(c)) = (
-                pos[idx[0] as usize],
-                pos[idx[1] as usize],
-                pos[idx[2] as usize],
-            ) else {
-                continue;
+    let (k, triangles, segments, mut info) = match fast {
+        Some(tess) => {
+            timings.evaluate = start.elapsed();
+            let info = LayerInfo {
+                level: tess.level,
+                capped: tess.capped,
+                quads: tess.quads,
+                triangles: tess.triangles.len(),
+                max_quad_px: tess.measured.extent,
+                max_outline_deviation_px: tess.measured.outline,
+                max_colour_error: tess.measured.colour,
+                estimated: tess.estimated,
+                timings,
             };
-            let v = [a, b, c];
-            let outside = v.iter().all(|p| p[0] < 0)
-                || v.iter().all(|p| p[0] > xmax)
-                || v.iter().all(|p| p[1] < 0)
-                || v.iter().all(|p| p[1] > ymax);
-            // No pixel centre column between the leftmost and rightmost vertex: nothing to draw
-            // (at deep levels most quads are under a pixel).
-            let half = SUBPIXEL / 2;
-            let left = v.iter().map(|p| p[0]).min().expect("three vertices");
-            let right = v.iter().map(|p| p[0]).max().expect("three vertices");
-            let no_column = (left - half).div_euclid(SUBPIXEL)
-                == (right - half).div_euclid(SUBPIXEL)
-                && (left - half).rem_euclid(SUBPIXEL) != 0;
-            if outside || no_column {
-                continue;
-            }
-            let x = idx.map(|i| exact[i as usize]);
-            if let Some(tri) = Triangle::new(v, x, idx.map(attr)) {
-                if tri.rows.1 > 0 && tri.rows.0 < h && tri.rows.0 < tri.rows.1 {
-                    out.push(tri);
-                }
-            }
+            (tess.base_level, tess.triangles, tess.segments, info)
         }
-        out
+        None => {
+            let (choice, lim) = choose_level(&mut refinement, &mut data, xf, opts, space);
+            timings.evaluate = start.elapsed();
+            let (triangles, segments) =
+                uniform_triangles(refinement.topology(choice.level), &lim, xf, (w, h));
+            let info = LayerInfo {
+                level: choice.level,
+                capped: choice.capped,
+                quads: refinement.topology(choice.level).face_count(),
+                triangles: triangles.len(),
+                max_quad_px: choice.measured.map_or(f64::NAN, |m| m.extent),
+                max_outline_deviation_px: choice.measured.map_or(f64::NAN, |m| m.outline),
+                max_colour_error: choice.measured.map_or(f64::NAN, |m| m.colour),
+                estimated: choice.estimated,
+                timings,
+            };
+            (choice.level, triangles, segments, info)
+        }
     };
-    // Built in parallel, collected in face order.
-    let triangles: Vec<Triangle> = (0..t.face_count())
-        .into_par_iter()
-        .flat_map_iter(face_triangles)
-        .collect();
+    let start = Instant::now();
+    let t = refinement.topology(k);
     let ranges: Vec<(u32, usize, usize)> = triangles
         .iter()
         .enumerate()
@@ -533,34 +693,8 @@ pub(crate) fn prepare(
         )
     };
 
-    // Boundary edges of the tessellation, for outline pixels no triangle reaches.
-    let mut segments = Vec::new();
-    for lp in &loops {
-        for i in 0..lp.len() {
-            let (a, b) = (lp[i], lp[(i + 1) % lp.len()]);
-            if pos[a as usize].is_some() && pos[b as usize].is_some() {
-                let c = |v: u32| attr(v).map(|x| x as f32);
-                segments.push(Segment {
-                    a: exact[a as usize],
-                    b: exact[b as usize],
-                    ca: c(a),
-                    cb: c(b),
-                });
-            }
-        }
-    }
     let nearest = NearestSegments::new(segments);
-
-    let info = LayerInfo {
-        level: k,
-        capped: choice.capped,
-        quads: t.face_count(),
-        triangles: triangles.len(),
-        max_quad_px: choice.measured.map_or(f64::NAN, |m| m.extent),
-        max_outline_deviation_px: choice.measured.map_or(f64::NAN, |m| m.outline),
-        max_colour_error: choice.measured.map_or(f64::NAN, |m| m.colour),
-        estimated: choice.estimated,
-    };
+    info.timings.tessellate = start.elapsed();
     if lines.is_empty() || columns.0 >= columns.1 {
         return Ok((info, None, warnings));
     }

@@ -2,23 +2,42 @@
 //!
 //! For each layer (a [`GradientMesh`] of a [`Document`], bottom first):
 //!
-//! 1. **Level.** The mesh is refined uniformly until, over the quads that reach the image, the
-//!    colours the triangles show are within [`RenderOptions::colour_tolerance`] (about Delta E)
-//!    of the limit surface, the quads are at most [`RenderOptions::max_quad_px`] across and the
-//!    boundary edges within [`RenderOptions::tolerance_px`] of the outline. The colour error is
-//!    measured, not predicted: the face and edge points of the next level are the surface at the
-//!    quads' and edges' centres, and the error counted is between the limit colour at such a
-//!    point's true position and what the triangles show there, so the non-affine map from mesh
-//!    to plane (usually the larger term) is included. Errors inside quads under a pixel across
-//!    are not counted: what survives refinement that far sits at extraordinary and degenerate
-//!    points (a handle of length zero, say), where uniform refinement converges only linearly and
-//!    would refine the whole layer for a few pixels.
+//! 1. **Density.** The colours the triangles show must be within
+//!    [`RenderOptions::colour_tolerance`] (about Delta E) of the limit surface, the quads at most
+//!    [`RenderOptions::max_quad_px`] across and the boundary edges within
+//!    [`RenderOptions::tolerance_px`] of the outline. The colour error is measured, not
+//!    predicted: the surface at a quad's centre and at its sides' midpoints (the face and edge
+//!    points of the next level) against what the triangles show at the same position in the
+//!    plane, so the non-affine map from mesh to plane (usually the larger term) is included.
+//!    - **Fast path (feature-adaptive).** The mesh is refined to level 3 only (all quads,
+//!      extraordinary vertices isolated). Each face of that level gets its own grid density,
+//!      doubled until its cells pass the measure (colour held to half the tolerance, since each
+//!      face now stops right at it). A face whose neighbourhood is regular (valence-4 interior,
+//!      valence-3 boundary or corner vertices, no sharpness but the boundary's) is exactly a
+//!      uniform bicubic B-spline patch in position, colour and opacity, with phantom points
+//!      beyond a boundary, and is evaluated directly; any other face (extraordinary vertex,
+//!      crease, semi-sharp feature) is refined on its own, keeping at each depth only the faces
+//!      around its descendants. Faces of different densities are stitched without cracks: each
+//!      edge takes the finer count of its faces, both sides use bit-identical samples along it,
+//!      and the finer side collapses its extra boundary samples. Cells are drawn in the order
+//!      and with the diagonals of the quads uniform refinement would make (see `adaptive.rs`).
+//!      Faces whose control points all lie off the image are not refined.
+//!    - **Uniform path** (reference mode, [`RenderOptions::level`], a
+//!      [`RenderOptions::max_level`] under 3, or a layer the fast path does not handle). The
+//!      mesh is refined uniformly until every quad reaching the image passes. Errors inside
+//!      quads under a pixel across are not counted there: what survives refinement that far
+//!      sits at extraordinary and degenerate points (a handle of length zero, say), where
+//!      uniform refinement converges only linearly and would refine the whole layer for a few
+//!      pixels. (The fast path counts them where the quad's box holds a pixel centre: only
+//!      that face goes deeper.)
+//!
 //!    The rendering notes' measurement (quads of about 3 px within 0.011 CIEDE2000 of quads of
 //!    0.7 px) says colour needs no more than a few pixels per quad; the tests measure the result
-//!    against the reference mode. [`LayerInfo`] reports the level and whether a cap
-//!    ([`RenderOptions::max_level`], [`RenderOptions::max_quads`]) stopped it.
-//! 2. **Interior.** Every quad of that level, with the limit positions and colours of its
-//!    corners, is drawn as two triangles; colour and opacity are interpolated linearly in the
+//!    against the reference mode. [`LayerInfo`] reports the (finest) level, whether a cap
+//!    ([`RenderOptions::max_level`], [`RenderOptions::max_quads`]) stopped it, and the time of
+//!    each stage ([`LayerTimings`], [`RenderTimings`]).
+//! 2. **Interior.** Every quad (cell), with the limit positions and colours of its corners, is
+//!    drawn as two triangles; colour and opacity are interpolated linearly in the
 //!    mesh's working space at each pixel centre and only then converted. Vertices are snapped to
 //!    1/256 pixel and tested with exact integer edge functions and the top-left rule, so interior
 //!    edges have neither gaps nor double coverage. Where the surface folds over itself, later
@@ -56,6 +75,7 @@
 //! # Ok::<(), gradmesh::Error>(())
 //! ```
 
+mod adaptive;
 mod coverage;
 mod folds;
 mod gamut;
@@ -64,8 +84,11 @@ mod nearest;
 mod outline;
 mod output;
 mod overlay;
+mod patches;
 mod triangles;
 mod view;
+
+use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
@@ -244,12 +267,13 @@ impl RenderOptions {
 /// What was drawn for one layer.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct LayerInfo {
-    /// The refinement level drawn (0 for a layer without faces).
+    /// The refinement level drawn (0 for a layer without faces); on the fast path, the level
+    /// whose density the finest face has (faces each have their own).
     pub level: usize,
     /// Whether [`RenderOptions::max_level`] or [`RenderOptions::max_quads`] stopped the
     /// refinement before the quads met the size and tolerance asked for.
     pub capped: bool,
-    /// Quads at that level.
+    /// Quads at that level (on the fast path, the cells of all faces' grids).
     pub quads: usize,
     /// Triangles that reach the image.
     pub triangles: usize,
@@ -266,6 +290,29 @@ pub struct LayerInfo {
     /// Whether the three figures above are estimated from the level above (halving per level,
     /// the outline's distance quartering) rather than measured at the level drawn.
     pub estimated: bool,
+    /// Time spent on each stage of preparing this layer.
+    pub timings: LayerTimings,
+}
+
+/// Wall-clock time of the stages that prepare one layer (layers are prepared in parallel, so
+/// these add up to more than [`RenderTimings::prepare`] when there are several).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LayerTimings {
+    /// Validation, the first step and the topology and data of the levels built.
+    pub refine: Duration,
+    /// Limit stencils or patch evaluation, and measuring the error to choose the density.
+    pub evaluate: Duration,
+    /// Triangles, outline and nearest-boundary table built and binned into bands.
+    pub tessellate: Duration,
+}
+
+/// Wall-clock time of the stages of a whole render.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RenderTimings {
+    /// Every layer prepared (see [`LayerTimings`] for the split per layer).
+    pub prepare: Duration,
+    /// Rasterisation, outline coverage, colour conversion and compositing, all bands.
+    pub draw: Duration,
 }
 
 /// What was drawn.
@@ -275,6 +322,8 @@ pub struct RenderInfo {
     pub layers: Vec<LayerInfo>,
     /// Warnings from validating the layers (legal but suspicious input).
     pub warnings: Vec<Warning>,
+    /// Time spent on each stage.
+    pub timings: RenderTimings,
 }
 
 /// Renders `doc` into a new `f32` image: straight alpha, sRGB-encoded colour.
@@ -320,6 +369,7 @@ pub fn render_document_into<P: OutputPixel>(
         .into());
     }
     let xf = ToPixels::new(&opts.view, opts.width, opts.height);
+    let start = Instant::now();
     let prepared: Vec<layer::Prepared> = doc
         .layers
         .par_iter()
@@ -333,6 +383,7 @@ pub fn render_document_into<P: OutputPixel>(
         info.warnings.extend(warnings);
         layers.extend(layer);
     }
+    info.timings.prepare = start.elapsed();
 
     let background = opts.background.map(|bg| {
         let a = bg[3].clamp(0.0, 1.0);
@@ -343,12 +394,14 @@ pub fn render_document_into<P: OutputPixel>(
         };
         [rgb[0] * a, rgb[1] * a, rgb[2] * a, a]
     });
+    let start = Instant::now();
     out.par_chunks_mut(4 * w * BAND).enumerate().for_each_init(
         || Scratch::new(w),
         |scratch, (band, chunk)| {
             draw_band(band, chunk, &layers, opts, background, scratch);
         },
     );
+    info.timings.draw = start.elapsed();
     Ok(info)
 }
 

@@ -108,9 +108,11 @@ impl Image {
     }
 
     fn quantise<P: OutputPixel>(&self, dither: bool) -> Vec<P> {
+        use rayon::prelude::*;
         let w = self.width as usize;
+        // Each channel depends only on its own value and position: any split gives the same.
         self.data
-            .iter()
+            .par_iter()
             .enumerate()
             .map(|(i, &v)| {
                 let noise = if dither && P::DITHERED {
@@ -143,10 +145,11 @@ pub fn encode_png(image: &Image, bits: u8, dither: bool) -> Result<Vec<u8>, Erro
     let bytes: Vec<u8> = if bits == 8 {
         image.to_u8(dither)
     } else {
+        use rayon::prelude::*;
         image
             .to_u16()
-            .iter()
-            .flat_map(|v| v.to_be_bytes())
+            .par_iter()
+            .flat_map_iter(|v| v.to_be_bytes())
             .collect()
     };
     let io = |e: png::EncodingError| Error::from(ErrorKind::Io(format!("PNG encoding: {e}")));
@@ -156,6 +159,9 @@ pub fn encode_png(image: &Image, bits: u8, dither: bool) -> Result<Vec<u8>, Erro
         enc.set_color(png::ColorType::Rgba);
         enc.set_depth(depth);
         enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        // The fast deflate (fdeflate) with its own filter choice: several times faster than the
+        // default level for a few percent more bytes; the pixels are the same.
+        enc.set_compression(png::Compression::Fast);
         let mut writer = enc.write_header().map_err(io)?;
         writer.write_image_data(&bytes).map_err(io)?;
         writer.finish().map_err(io)?;

@@ -11,6 +11,10 @@
 pub(crate) const SUBPIXEL: i64 = 256;
 /// Snapped coordinates beyond this magnitude (2^32 pixels) are not rasterised.
 const LIMIT: i64 = 1 << 40;
+/// Vertices within this magnitude (2^18 pixels, in sub-pixel units)...
+const SMALL: i64 = 1 << 26;
+/// ...and rows within this one (2^16, twice the largest image side) take 64-bit arithmetic.
+const SMALL_ROWS: i64 = 1 << 16;
 
 /// Snaps a pixel coordinate to the sub-pixel grid; `None` if it is not finite or too large.
 pub(crate) fn snap(v: f64) -> Option<i64> {
@@ -33,6 +37,8 @@ pub(crate) struct Triangle {
     edges: [Edge; 3],
     /// First row and one past the last row whose centres may lie inside.
     pub rows: (i64, i64),
+    /// Whether every vertex lies within [`SMALL`] of the origin.
+    small: bool,
     /// Attribute values are `base + gx * x + gy * y` at pixel coordinates (x, y).
     base: [f64; 4],
     gx: [f64; 4],
@@ -77,6 +83,7 @@ impl Triangle {
                 include: d[1] > 0 || (d[1] == 0 && d[0] < 0),
             }
         });
+        let small = v.iter().flatten().all(|c| c.abs() < SMALL);
         let ymin = v.iter().map(|p| p[1]).min().expect("three vertices");
         let ymax = v.iter().map(|p| p[1]).max().expect("three vertices");
         let half = SUBPIXEL / 2;
@@ -100,6 +107,7 @@ impl Triangle {
             return Some(Triangle {
                 edges,
                 rows,
+                small,
                 base,
                 gx,
                 gy,
@@ -114,6 +122,7 @@ impl Triangle {
         Some(Triangle {
             edges,
             rows,
+            small,
             base,
             gx,
             gy,
@@ -123,6 +132,55 @@ impl Triangle {
     /// The columns `[start, end)` of row `j` whose pixel centres lie inside, clipped to
     /// `0..width`.
     pub fn span(&self, j: i64, width: i64) -> (i64, i64) {
+        if self.small && j.abs() < SMALL_ROWS {
+            self.span_small(j, width)
+        } else {
+            self.span_wide(j, width)
+        }
+    }
+
+    /// [`Triangle::span`] in 64-bit integers: exact when the vertices lie within [`SMALL`] and
+    /// the row within [`SMALL_ROWS`] (every product stays under 2^55), and several times faster
+    /// than 128-bit division. Same arithmetic, same answers.
+    fn span_small(&self, j: i64, width: i64) -> (i64, i64) {
+        let half = SUBPIXEL / 2;
+        let ry = j * SUBPIXEL + half;
+        let (mut start, mut end) = (0i64, width);
+        for e in &self.edges {
+            let (px, py) = (e.p[0], e.p[1]);
+            let (dx, dy) = (e.d[0], e.d[1]);
+            let k = dx * (ry - py) - dy * (half - px);
+            let m = dy * SUBPIXEL;
+            if m == 0 {
+                if !(k > 0 || (k == 0 && e.include)) {
+                    return (0, 0);
+                }
+            } else if m > 0 {
+                let stop = if e.include {
+                    k.div_euclid(m) + 1
+                } else {
+                    -((-k).div_euclid(m))
+                };
+                end = end.min(stop);
+            } else {
+                let n = -m;
+                let first = if e.include {
+                    -(k.div_euclid(n))
+                } else {
+                    (-k).div_euclid(n) + 1
+                };
+                start = start.max(first);
+            }
+        }
+        if start >= end {
+            (0, 0)
+        } else {
+            (start, end)
+        }
+    }
+
+    /// [`Triangle::span`] in 128-bit integers, for any snapped coordinates.
+    fn span_wide(&self, j: i64, width: i64) -> (i64, i64) {
         let half = (SUBPIXEL / 2) as i128;
         let ry = j as i128 * SUBPIXEL as i128 + half;
         let (mut start, mut end) = (0i128, width as i128);
@@ -256,6 +314,28 @@ mod tests {
         assert_eq!(hits[8 * 24 + 8], 1);
         let covered = hits.iter().filter(|&&h| h == 1).count();
         assert!(covered > 200);
+    }
+
+    #[test]
+    fn narrow_and_wide_spans_agree() {
+        // Awkward vertices, both orientations, rows through and beside them.
+        let mut seed = 0x2545_f491_u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed % 20_000) as f64 / 37.0 - 20.0
+        };
+        for _ in 0..2000 {
+            let v = [0, 1, 2].map(|_| p(next(), next()));
+            let Some(t) = Triangle::new(v, [[0.0; 2]; 3], [[0.0; 4]; 3]) else {
+                continue;
+            };
+            assert!(t.small);
+            for j in t.rows.0 - 1..=t.rows.1 {
+                assert_eq!(t.span_small(j, 600), t.span_wide(j, 600));
+            }
+        }
     }
 
     #[test]

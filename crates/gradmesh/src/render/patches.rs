@@ -1,0 +1,584 @@
+//! Feature-adaptive evaluation of the limit surface, face by face of a low, all-quad level.
+//!
+//! A face of such a level whose corners are regular (interior of valence 4, regular boundary of
+//! valence 3 or a corner with one face; no sharp or semi-sharp edge at them other than the
+//! boundary, no vertex sharpness other than an infinitely sharp corner) is exactly a uniform
+//! bicubic B-spline patch of its 16 surrounding points, in position as in colour and opacity,
+//! because every later level applies the regular rules there. Missing points beyond a boundary
+//! are phantoms `2 b - interior`, which reproduce the boundary rules (midpoint edges, `(1 6 1) / 8`
+//! vertices, fixed corners), as OpenSubdiv's boundary and corner patches do. Such a patch is
+//! evaluated directly on a grid of any density.
+//!
+//! Any other face (next to an extraordinary vertex, a crease or a semi-sharp feature) is
+//! refined locally: the faces around its corners, extracted as a small mesh with their
+//! sharpness, determine its whole limit surface, so refining that small mesh and applying the
+//! limit stencils gives the same grid as refining the whole layer would.
+
+use crate::catmull_clark::{self, Level};
+use crate::limit;
+use crate::mesh::BoundaryInterpolation;
+use crate::rules::{self, VertexRule};
+use crate::topology::Topology;
+use crate::validate::VertexData;
+
+/// Samples `(n + 1)^2` of the limit surface over one face, row by row: index `j * (n + 1) + i`
+/// is at parameter `(i / n, j / n)`, `u` running from the face's corner 0 to corner 1 and `v`
+/// from corner 0 to corner 3.
+pub(crate) type Grid = Vec<VertexData>;
+
+/// The 16 control points of a regular patch: `cp[j][i]`, `i` along `u`, `j` along `v`; the
+/// face's corners are `cp[1][1]`, `cp[1][2]`, `cp[2][2]` and `cp[2][1]`.
+pub(crate) type ControlGrid = [[VertexData; 4]; 4];
+
+/// Where corner `c` of the face sits in the control grid, as `(i, j)`.
+const GRID_CORNERS: [(isize, isize); 4] = [(1, 1), (2, 1), (2, 2), (1, 2)];
+
+/// The uniform cubic B-spline basis functions at `t` in `0..=1`.
+pub(crate) fn bspline_basis(t: f64) -> [f64; 4] {
+    let s = 1.0 - t;
+    let (t2, t3) = (t * t, t * t * t);
+    [
+        s * s * s / 6.0,
+        (3.0 * t3 - 6.0 * t2 + 4.0) / 6.0,
+        (-3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0) / 6.0,
+        t3 / 6.0,
+    ]
+}
+
+/// The patch of `cp` at parameter `(u, v)`.
+#[cfg(test)]
+pub(crate) fn evaluate_patch_at(cp: &ControlGrid, u: f64, v: f64) -> VertexData {
+    let (bu, bv) = (bspline_basis(u), bspline_basis(v));
+    let mut p = [0.0; 6];
+    for (j, row) in cp.iter().enumerate() {
+        for (i, point) in row.iter().enumerate() {
+            let w = bu[i] * bv[j];
+            for k in 0..6 {
+                p[k] += w * point[k];
+            }
+        }
+    }
+    p
+}
+
+/// The patch of `cp` on a grid of `n x n` cells.
+pub(crate) fn evaluate_patch(cp: &ControlGrid, n: usize) -> Grid {
+    let basis: Vec<[f64; 4]> = (0..=n)
+        .map(|i| bspline_basis(i as f64 / n as f64))
+        .collect();
+    let mut out = Vec::with_capacity((n + 1) * (n + 1));
+    for bv in &basis {
+        // The four columns collapsed to this row's curve first: 16 then 4 terms per sample.
+        let mut q = [[0.0; 6]; 4];
+        for (i, qi) in q.iter_mut().enumerate() {
+            for (j, row) in cp.iter().enumerate() {
+                for k in 0..6 {
+                    qi[k] += bv[j] * row[i][k];
+                }
+            }
+        }
+        for bu in &basis {
+            let mut p = [0.0; 6];
+            for (i, qi) in q.iter().enumerate() {
+                for k in 0..6 {
+                    p[k] += bu[i] * qi[k];
+                }
+            }
+            out.push(p);
+        }
+    }
+    out
+}
+
+/// Whether vertex `v` keeps the regular B-spline rules at every later level: interior of
+/// valence 4, boundary of valence 3 or a corner with a single face, with no sharpness but the
+/// boundary's (and the corner's).
+fn regular_corner(level: &Level, v: usize) -> bool {
+    let t = &level.topology;
+    let edges = t.vertex_edges(v);
+    let faces = t.vertex_faces(v);
+    for &e in edges {
+        let s = level.edge_sharpness[e as usize];
+        let fine = if t.is_boundary_edge(e as usize) {
+            rules::is_infinite(s)
+        } else {
+            s == 0.0
+        };
+        if !fine {
+            return false;
+        }
+    }
+    if faces
+        .iter()
+        .any(|&f| t.face_vertices(f as usize).len() != 4)
+    {
+        return false;
+    }
+    let sharpness = level.vertex_sharpness[v];
+    match (t.is_boundary_vertex(v), faces.len(), edges.len()) {
+        (false, 4, 4) | (true, 2, 3) => sharpness == 0.0,
+        (true, 1, 2) => rules::is_infinite(sharpness) && level.vertex_rule(v) == VertexRule::Corner,
+        _ => false,
+    }
+}
+
+/// The control points of face `f` of `level` (with data `data`) if its limit surface is a
+/// regular B-spline patch (see the module documentation), phantom points included.
+pub(crate) fn regular_patch(level: &Level, data: &[VertexData], f: usize) -> Option<ControlGrid> {
+    let t = &level.topology;
+    let fv = t.face_vertices(f);
+    if fv.len() != 4 {
+        return None;
+    }
+    let mut index: [[Option<u32>; 4]; 4] = [[None; 4]; 4];
+    // Each outer point is reached from two corners: both must agree.
+    let mut put = |(i, j): (isize, isize), v: u32| -> bool {
+        let slot = &mut index[j as usize][i as usize];
+        match *slot {
+            Some(w) => w == v,
+            None => {
+                *slot = Some(v);
+                true
+            }
+        }
+    };
+    let add = |a: (isize, isize), b: (isize, isize)| (a.0 + b.0, a.1 + b.1);
+    let sub = |a: (isize, isize), b: (isize, isize)| (a.0 - b.0, a.1 - b.1);
+    for c in 0..4 {
+        let v = fv[c] as usize;
+        if !regular_corner(level, v) {
+            return None;
+        }
+        let (g, g_next, g_prev) = (
+            GRID_CORNERS[c],
+            GRID_CORNERS[(c + 1) % 4],
+            GRID_CORNERS[(c + 3) % 4],
+        );
+        // Outward across the edge to the previous corner, and across the edge to the next.
+        let (a, b) = (sub(g, g_next), sub(g, g_prev));
+        if !put(g, v as u32) {
+            return None;
+        }
+        let (next, prev) = (fv[(c + 1) % 4], fv[(c + 3) % 4]);
+        for (&face, &corner) in t.vertex_faces(v).iter().zip(t.vertex_face_corners(v)) {
+            if face as usize == f {
+                continue;
+            }
+            let gv = t.face_vertices(face as usize);
+            let k = corner as usize;
+            let (after, opposite, before) = (gv[(k + 1) % 4], gv[(k + 2) % 4], gv[(k + 3) % 4]);
+            let ok = if after == next || before == next {
+                let other = if after == next { before } else { after };
+                put(add(g, b), other) && put(add(g_next, b), opposite)
+            } else if after == prev || before == prev {
+                let other = if after == prev { before } else { after };
+                put(add(g, a), other) && put(add(g_prev, a), opposite)
+            } else {
+                put(add(add(g, a), b), opposite)
+            };
+            if !ok {
+                return None;
+            }
+        }
+    }
+    let mut cp = [[[0.0; 6]; 4]; 4];
+    let mut real = [[false; 4]; 4];
+    for j in 0..4 {
+        for i in 0..4 {
+            if let Some(v) = index[j][i] {
+                cp[j][i] = data[v as usize];
+                real[j][i] = true;
+            }
+        }
+    }
+    let reflect = |a: VertexData, b: VertexData| -> VertexData {
+        let mut r = [0.0; 6];
+        for k in 0..6 {
+            r[k] = 2.0 * a[k] - b[k];
+        }
+        r
+    };
+    // Phantoms beside the face's sides first (from the face's own corners)...
+    for m in 1..=2 {
+        if !real[m][0] {
+            cp[m][0] = reflect(cp[m][1], cp[m][2]);
+        }
+        if !real[m][3] {
+            cp[m][3] = reflect(cp[m][2], cp[m][1]);
+        }
+        if !real[0][m] {
+            cp[0][m] = reflect(cp[1][m], cp[2][m]);
+        }
+        if !real[3][m] {
+            cp[3][m] = reflect(cp[2][m], cp[1][m]);
+        }
+    }
+    // ...then the outer corners, reflected across the boundary: along whichever line towards
+    // the face holds real points (both are phantoms at a corner of the mesh, and agree).
+    for (j, i, dj, di) in [(0, 0, 1, 1), (0, 3, 1, -1), (3, 0, -1, 1), (3, 3, -1, -1)] {
+        if real[j][i] {
+            continue;
+        }
+        let (j1, j2) = ((j as isize + dj) as usize, (j as isize + 2 * dj) as usize);
+        let (i1, i2) = ((i as isize + di) as usize, (i as isize + 2 * di) as usize);
+        cp[j][i] = if real[j1][i] && real[j2][i] {
+            reflect(cp[j1][i], cp[j2][i])
+        } else {
+            reflect(cp[j][i1], cp[j][i2])
+        };
+    }
+    Some(cp)
+}
+
+/// One quad of a locally refined face at some depth: its index in that level, and where its
+/// corners 0, 1, 2, 3 sit in the face's grid of `2^depth` cells a side (origin, step from
+/// corner 0 to 1, step from corner 0 to 3).
+#[derive(Clone, Copy, Debug)]
+struct Tile {
+    face: u32,
+    origin: [i64; 2],
+    u: [i64; 2],
+    v: [i64; 2],
+}
+
+/// One depth of a locally refined face: the faces around its descendants, as their own mesh.
+struct LocalLevel {
+    level: Level,
+    data: Vec<VertexData>,
+    tiles: Vec<Tile>,
+}
+
+/// A face refined on its own: at each depth only the faces around its descendants (which
+/// determine their limit surface) are kept, so the cost grows with the face's own samples.
+pub(crate) struct LocalPatch {
+    levels: Vec<LocalLevel>,
+}
+
+/// The faces `keep` of `level` (with data `data`) as a mesh of their own, and the index of each
+/// kept face in it (`u32::MAX` for the others). The cut around them becomes a boundary
+/// (infinitely sharp): it changes only points that the kept faces' inner limit surface does not
+/// depend on.
+fn extract(
+    level: &Level,
+    data: &[VertexData],
+    keep: &[u32],
+) -> Option<(Level, Vec<VertexData>, Vec<u32>)> {
+    let t = &level.topology;
+    let mut vertex_map = vec![u32::MAX; t.vertex_count()];
+    let mut face_map = vec![u32::MAX; t.face_count()];
+    let mut vertices: Vec<u32> = Vec::new();
+    let faces: Vec<Vec<u32>> = keep
+        .iter()
+        .enumerate()
+        .map(|(k, &g)| {
+            face_map[g as usize] = k as u32;
+            t.face_vertices(g as usize)
+                .iter()
+                .map(|&v| {
+                    if vertex_map[v as usize] == u32::MAX {
+                        vertex_map[v as usize] = vertices.len() as u32;
+                        vertices.push(v);
+                    }
+                    vertex_map[v as usize]
+                })
+                .collect()
+        })
+        .collect();
+    let topology = Topology::from_faces(vertices.len(), &faces).ok()?;
+    let edge_sharpness = (0..topology.edge_count())
+        .map(|e| {
+            let [a, b] = topology.edge_vertices(e);
+            let (ga, gb) = (vertices[a as usize], vertices[b as usize]);
+            t.vertex_edges(ga as usize)
+                .iter()
+                .find(|&&ge| t.other_vertex(ge as usize, ga) == gb)
+                .map_or(0.0, |&ge| level.edge_sharpness[ge as usize])
+        })
+        .collect();
+    let vertex_sharpness = vertices
+        .iter()
+        .map(|&v| level.vertex_sharpness[v as usize])
+        .collect();
+    let local = Level::new(
+        topology,
+        edge_sharpness,
+        vertex_sharpness,
+        level.creasing,
+        BoundaryInterpolation::EdgeOnly,
+    );
+    let local_data = vertices.iter().map(|&v| data[v as usize]).collect();
+    Some((local, local_data, face_map))
+}
+
+/// The faces of `t` that share a vertex with one of `tiles`, in increasing order.
+fn neighbourhood(t: &Topology, tiles: &[Tile]) -> Vec<u32> {
+    let mut faces: Vec<u32> = tiles
+        .iter()
+        .flat_map(|tile| t.face_vertices(tile.face as usize))
+        .flat_map(|&v| t.vertex_faces(v as usize).iter().copied())
+        .collect();
+    faces.sort_unstable();
+    faces.dedup();
+    faces
+}
+
+impl LocalPatch {
+    /// Extracts the neighbourhood of face `f` of `level`; `None` if it is not a quad or the
+    /// neighbourhood does not form a valid mesh on its own.
+    pub fn new(level: &Level, data: &[VertexData], f: usize) -> Option<LocalPatch> {
+        if level.topology.face_vertices(f).len() != 4 {
+            return None;
+        }
+        let whole = Tile {
+            face: f as u32,
+            origin: [0, 0],
+            u: [1, 0],
+            v: [0, 1],
+        };
+        let keep = neighbourhood(&level.topology, &[whole]);
+        let (local, local_data, map) = extract(level, data, &keep)?;
+        let tiles = vec![Tile {
+            face: map[f],
+            ..whole
+        }];
+        Some(LocalPatch {
+            levels: vec![LocalLevel {
+                level: local,
+                data: local_data,
+                tiles,
+            }],
+        })
+    }
+
+    /// The data of the neighbourhood's points: the face's limit surface lies in their convex
+    /// hull.
+    pub fn control_points(&self) -> &[VertexData] {
+        &self.levels[0].data
+    }
+
+    /// Refines the last depth once and keeps the faces around the new tiles.
+    fn deepen(&mut self) -> Option<()> {
+        let last = self.levels.last().expect("depth 0");
+        let (child, stencils) = catmull_clark::refine(&last.level);
+        let child_data = stencils.apply(&last.data);
+        let mut tiles = Vec::with_capacity(4 * last.tiles.len());
+        for tile in &last.tiles {
+            // Corners in the grid of the next depth (twice as fine).
+            let o = [2 * tile.origin[0], 2 * tile.origin[1]];
+            let corners = [
+                o,
+                [o[0] + 2 * tile.u[0], o[1] + 2 * tile.u[1]],
+                [
+                    o[0] + 2 * (tile.u[0] + tile.v[0]),
+                    o[1] + 2 * (tile.u[1] + tile.v[1]),
+                ],
+                [o[0] + 2 * tile.v[0], o[1] + 2 * tile.v[1]],
+            ];
+            let first = last.level.topology.face_offset(tile.face as usize);
+            // Child c sits at corner c, its first side along side c, its last along side c - 1.
+            for c in 0..4 {
+                let p = corners[c];
+                let towards = |q: [i64; 2]| [(q[0] - p[0]) / 2, (q[1] - p[1]) / 2];
+                tiles.push(Tile {
+                    face: (first + c) as u32,
+                    origin: p,
+                    u: towards(corners[(c + 1) % 4]),
+                    v: towards(corners[(c + 3) % 4]),
+                });
+            }
+        }
+        let keep = neighbourhood(&child.topology, &tiles);
+        let (level, data, map) = extract(&child, &child_data, &keep)?;
+        for tile in &mut tiles {
+            tile.face = map[tile.face as usize];
+        }
+        self.levels.push(LocalLevel { level, data, tiles });
+        Some(())
+    }
+
+    /// The limit surface over the face on a grid of `n x n` cells (`n` a power of two): its
+    /// descendants `log2 n` levels down, at their limit positions.
+    pub fn grid(&mut self, n: usize) -> Option<Grid> {
+        let depth = n.trailing_zeros() as usize;
+        while self.levels.len() <= depth {
+            self.deepen()?;
+        }
+        let at = &self.levels[depth];
+        let limits = limit::limit_stencils(&at.level)?.apply(&at.data);
+        let stride = n as i64 + 1;
+        let mut grid = vec![[0.0; 6]; (n + 1) * (n + 1)];
+        let t = &at.level.topology;
+        for tile in &at.tiles {
+            let o = tile.origin;
+            let corners = [
+                o,
+                [o[0] + tile.u[0], o[1] + tile.u[1]],
+                [o[0] + tile.u[0] + tile.v[0], o[1] + tile.u[1] + tile.v[1]],
+                [o[0] + tile.v[0], o[1] + tile.v[1]],
+            ];
+            for (k, &v) in t.face_vertices(tile.face as usize).iter().enumerate() {
+                let p = corners[k];
+                grid[(p[1] * stride + p[0]) as usize] = limits[v as usize];
+            }
+        }
+        Some(grid)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::catmull_clark::refine;
+    use crate::mesh::CreasingMethod;
+
+    /// An `n x n` grid of quads (vertex `j * (n + 1) + i`) with the boundary rules applied
+    /// (corners infinitely sharp) and uneven data in all six coordinates.
+    fn grid_level(n: u32) -> (Level, Vec<VertexData>) {
+        let mut faces = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let v = j * (n + 1) + i;
+                faces.push(vec![v, v + 1, v + n + 2, v + n + 1]);
+            }
+        }
+        let nv = ((n + 1) * (n + 1)) as usize;
+        let topology = Topology::from_faces(nv, &faces).unwrap();
+        let ne = topology.edge_count();
+        let level = Level::new(
+            topology,
+            vec![0.0; ne],
+            vec![0.0; nv],
+            CreasingMethod::Uniform,
+            BoundaryInterpolation::EdgeAndCorner,
+        );
+        (level, uneven_data(nv))
+    }
+
+    fn uneven_data(nv: usize) -> Vec<VertexData> {
+        (0..nv)
+            .map(|k| {
+                let x = k as f64;
+                [
+                    x * 1.3 + (x * 0.7).sin() * 2.0,
+                    (x * 1.9).cos() * 3.0 + x * 0.2,
+                    50.0 + 10.0 * (x * 0.37).sin(),
+                    x * x * 0.01,
+                    -(x * 0.11).cos(),
+                    0.5 + 0.4 * (x * 0.5).sin(),
+                ]
+            })
+            .collect()
+    }
+
+    fn close(a: VertexData, b: VertexData) -> bool {
+        (0..6).all(|k| (a[k] - b[k]).abs() < 1e-9 * (1.0 + a[k].abs()))
+    }
+
+    /// The patch of face `f` at its corners equals the limit stencils; at its centre and side
+    /// midpoints, the limits of the next level's face and edge points.
+    fn check_patch(level: &Level, data: &[VertexData], f: usize) {
+        let cp = regular_patch(level, data, f).expect("regular");
+        let t = &level.topology;
+        let lim = limit::limit_stencils(level).unwrap().apply(data);
+        let fv = t.face_vertices(f);
+        let corners = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+        for (k, &(u, v)) in corners.iter().enumerate() {
+            let p = evaluate_patch_at(&cp, u, v);
+            assert!(close(p, lim[fv[k] as usize]), "face {f} corner {k}: {p:?}");
+        }
+        let (child, stencils) = refine(level);
+        let lim1 = limit::limit_stencils(&child)
+            .unwrap()
+            .apply(&stencils.apply(data));
+        let centre = evaluate_patch_at(&cp, 0.5, 0.5);
+        assert!(close(centre, lim1[f]), "face {f} centre");
+        let mids = [(0.5, 0.0), (1.0, 0.5), (0.5, 1.0), (0.0, 0.5)];
+        for (k, &(u, v)) in mids.iter().enumerate() {
+            let e = t.face_edges(f)[k] as usize;
+            let p = evaluate_patch_at(&cp, u, v);
+            assert!(close(p, lim1[t.face_count() + e]), "face {f} side {k}");
+        }
+        // The grid evaluation agrees with the pointwise one.
+        let g = evaluate_patch(&cp, 4);
+        assert!(close(g[5 * 2 + 3], evaluate_patch_at(&cp, 0.75, 0.5)));
+    }
+
+    #[test]
+    fn regular_patches_match_limit_stencils_inside_on_boundaries_and_corners() {
+        let (level, data) = grid_level(4);
+        // Interior (5), boundary sides (1, 4, 7, 13), corners (0, 3, 12, 15).
+        for f in [5, 6, 10, 1, 4, 7, 13, 0, 3, 12, 15] {
+            check_patch(&level, &data, f);
+        }
+    }
+
+    #[test]
+    fn irregular_faces_are_not_patches_and_refine_locally_like_the_whole_mesh() {
+        // A valence-5 vertex: five quads around vertex 0, with a ring of quads around them.
+        let (level, data) = star_level();
+        let t = &level.topology;
+        let centre = (0..t.vertex_count())
+            .find(|&v| t.vertex_edges(v).len() == 5)
+            .unwrap() as u32;
+        for f in 0..t.face_count() {
+            if t.face_vertices(f).contains(&centre) {
+                assert!(regular_patch(&level, &data, f).is_none());
+            }
+        }
+        // Local refinement of face 0 (an irregular face) equals refining the whole mesh: two
+        // levels down.
+        assert!(t.face_vertices(0).contains(&centre));
+        let mut local = LocalPatch::new(&level, &data, 0).unwrap();
+        let g = local.grid(4).unwrap();
+        let (l1, s1) = refine(&level);
+        let (l2, s2) = refine(&l1);
+        let d2 = s2.apply(&s1.apply(&data));
+        let lim = limit::limit_stencils(&l2).unwrap().apply(&d2);
+        // Grid corner (0, 0) is the face's corner 0; (4, 4) its corner 2; (2, 2) its centre,
+        // which is vertex point of the level-1 face point 0 (face 0 at level 1).
+        let (nf0, ne0) = (t.face_count(), t.edge_count());
+        let (nf1, ne1) = (l1.topology.face_count(), l1.topology.edge_count());
+        let fv = t.face_vertices(0);
+        let vertex_point_2 = |v: usize| nf1 + ne1 + nf0 + ne0 + v;
+        assert!(close(g[0], lim[vertex_point_2(fv[0] as usize)]));
+        assert!(close(g[24], lim[vertex_point_2(fv[2] as usize)]));
+        assert!(close(g[12], lim[nf1 + ne1]));
+        // A regular face of the same mesh refined locally equals its patch.
+        let regular = (0..t.face_count())
+            .find(|&f| regular_patch(&level, &data, f).is_some())
+            .expect("a regular face");
+        let cp = regular_patch(&level, &data, regular).unwrap();
+        let a = LocalPatch::new(&level, &data, regular)
+            .unwrap()
+            .grid(4)
+            .unwrap();
+        let b = evaluate_patch(&cp, 4);
+        for (p, q) in a.iter().zip(&b) {
+            assert!(close(*p, *q), "{p:?} vs {q:?}");
+        }
+    }
+
+    /// Level 2 of a five-quad star subdivided twice: a valence-5 vertex (0) in an all-quad mesh
+    /// with regular faces away from it.
+    fn star_level() -> (Level, Vec<VertexData>) {
+        let faces: Vec<Vec<u32>> = (0..5u32)
+            .map(|k| vec![0, 1 + k, 6 + k, 1 + (k + 1) % 5])
+            .collect();
+        let topology = Topology::from_faces(11, &faces).unwrap();
+        let ne = topology.edge_count();
+        let mut level = Level::new(
+            topology,
+            vec![0.0; ne],
+            vec![0.0; 11],
+            CreasingMethod::Uniform,
+            BoundaryInterpolation::EdgeAndCorner,
+        );
+        let mut data = uneven_data(11);
+        for _ in 0..2 {
+            let (child, st) = refine(&level);
+            data = st.apply(&data);
+            level = child;
+        }
+        (level, data)
+    }
+}
