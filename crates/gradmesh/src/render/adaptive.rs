@@ -230,12 +230,14 @@ pub(super) fn tessellate(
     max_level: usize,
     size: (i64, i64),
 ) -> Option<Tessellation> {
-    let mut k0 = BASE_LEVEL;
+    // Faces refine on their own from the base level with bare stencils: it must lie below the
+    // rings of the deepest multi-resolution edit.
+    let mut k0 = BASE_LEVEL.max(refinement.base().edits.deepest_level() + 1);
     loop {
         while data.levels.len() <= k0 {
             let j = data.levels.len() - 1;
             refinement.extend_to(j + 1);
-            let next = refinement.stencils(j).apply(&data.levels[j]);
+            let next = refinement.next_level_data(j, &data.levels[j]);
             data.levels.push(next);
         }
         if !semi_sharp_on_boundary(refinement.level(k0)) {
