@@ -96,6 +96,111 @@ impl ColourSpace {
     }
 }
 
+/// A 3x3 matrix, rows first.
+pub type Matrix3 = [[f64; 3]; 3];
+
+impl ColourSpace {
+    /// The derivative of the map from this space to CIE Lab at `c`: a small difference `d` of
+    /// colours near `c` is about `J d` in Lab. Renderers use it to measure colour errors in Lab
+    /// units for a price of one conversion per sample instead of two per comparison.
+    pub fn lab_jacobian(self, c: [f64; 3]) -> Matrix3 {
+        match self {
+            ColourSpace::Lab => [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+            ColourSpace::Oklab => Self::oklab_to_lab_jacobian(c),
+            ColourSpace::SrgbLinear => linear_srgb_to_lab_jacobian(c),
+            ColourSpace::Srgb => {
+                let lin = c.map(srgb_decode);
+                let slope = c.map(srgb_decode_slope);
+                let mut j = linear_srgb_to_lab_jacobian(lin);
+                for row in &mut j {
+                    for k in 0..3 {
+                        row[k] *= slope[k];
+                    }
+                }
+                j
+            }
+        }
+    }
+
+    /// Oklab has no closed form in Lab worth the trouble: forward differences, with a step
+    /// far below the differences being measured and far above rounding.
+    fn oklab_to_lab_jacobian(c: [f64; 3]) -> Matrix3 {
+        const H: f64 = 1e-6;
+        let at = ColourSpace::Oklab.convert(ColourSpace::Lab, c);
+        let mut j = [[0.0; 3]; 3];
+        for k in 0..3 {
+            let mut ck = c;
+            ck[k] += H;
+            let moved = ColourSpace::Oklab.convert(ColourSpace::Lab, ck);
+            for i in 0..3 {
+                j[i][k] = (moved[i] - at[i]) / H;
+            }
+        }
+        j
+    }
+}
+
+/// The derivative of the sRGB decoding function (symmetric, as [`srgb_decode`]).
+fn srgb_decode_slope(encoded: f64) -> f64 {
+    let a = encoded.abs();
+    if a <= 0.040_45 {
+        1.0 / 12.92
+    } else {
+        2.4 / 1.055 * ((a + 0.055) / 1.055).powf(1.4)
+    }
+}
+
+/// The derivative of linear sRGB to CIE Lab (D65) at `rgb`. Lab is `A f(N rgb) + b` with `N`
+/// the linear map to white-relative XYZ and `f` the Lab function applied per channel, so the
+/// derivative is `A diag(f'(N rgb)) N`. `N` is read off `palette`'s own conversion (on colours
+/// so dark that `f` is affine there), so the two agree.
+fn linear_srgb_to_lab_jacobian(rgb: [f64; 3]) -> Matrix3 {
+    const DELTA: f64 = 6.0 / 29.0;
+    static N: std::sync::OnceLock<Matrix3> = std::sync::OnceLock::new();
+    let n = N.get_or_init(|| {
+        // In the affine part, fy = (L + 16) / 116, fx = fy + a / 500, fz = fy - b / 200, and
+        // t = 3 delta^2 (f - 4 / 29).
+        let eps = 1e-4;
+        let t_of = |lab: [f64; 3]| {
+            let fy = (lab[0] + 16.0) / 116.0;
+            let f = [fy + lab[1] / 500.0, fy, fy - lab[2] / 200.0];
+            f.map(|f| 3.0 * DELTA * DELTA * (f - 4.0 / 29.0))
+        };
+        let mut n = [[0.0; 3]; 3];
+        for k in 0..3 {
+            let mut probe = [0.0; 3];
+            probe[k] = eps;
+            let t = t_of(ColourSpace::Lab.from_linear_srgb(probe));
+            for i in 0..3 {
+                n[i][k] = t[i] / eps;
+            }
+        }
+        n
+    });
+    let t: [f64; 3] = [0, 1, 2].map(|i| n[i][0] * rgb[0] + n[i][1] * rgb[1] + n[i][2] * rgb[2]);
+    let slope = t.map(|t| {
+        if t > DELTA * DELTA * DELTA {
+            let r = t.cbrt();
+            1.0 / (3.0 * r * r)
+        } else {
+            1.0 / (3.0 * DELTA * DELTA)
+        }
+    });
+    // Rows of A: L = 116 fy - 16, a = 500 (fx - fy), b = 200 (fy - fz).
+    let a = [
+        [0.0, 116.0, 0.0],
+        [500.0, -500.0, 0.0],
+        [0.0, 200.0, -200.0],
+    ];
+    let mut j = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for k in 0..3 {
+            j[i][k] = (0..3).map(|m| a[i][m] * slope[m] * n[m][k]).sum();
+        }
+    }
+    j
+}
+
 /// The sRGB transfer function (encoding), extended to negative values by symmetry.
 pub fn srgb_encode(linear: f64) -> f64 {
     let a = linear.abs();
@@ -133,6 +238,44 @@ pub fn parse_css_colour(text: &str, space: ColourSpace) -> Result<([f64; 3], f64
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lab_jacobian_matches_differences() {
+        let samples = [
+            [0.2, 0.5, 0.8],
+            [0.9, 0.1, 0.4],
+            [0.01, 0.02, 0.015],
+            [-0.05, 0.5, 1.1],
+        ];
+        for space in ColourSpace::ALL {
+            for rgb in samples {
+                let c = space.from_linear_srgb(rgb);
+                let j = space.lab_jacobian(c);
+                for k in 0..3 {
+                    // Central differences, a step of about 1e-5 of the space's range.
+                    let h = if space == ColourSpace::Lab {
+                        1e-3
+                    } else {
+                        1e-5
+                    };
+                    let (mut up, mut down) = (c, c);
+                    up[k] += h;
+                    down[k] -= h;
+                    let up = space.convert(ColourSpace::Lab, up);
+                    let down = space.convert(ColourSpace::Lab, down);
+                    for i in 0..3 {
+                        let diff = (up[i] - down[i]) / (2.0 * h);
+                        let tol = 1e-3 * (1.0 + diff.abs());
+                        assert!(
+                            (diff - j[i][k]).abs() < tol,
+                            "{space:?} at {c:?}: J[{i}][{k}] = {} but differences give {diff}",
+                            j[i][k]
+                        );
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn lab_white_is_srgb_white() {

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use crate::colour::ColourSpace;
+use crate::colour::{ColourSpace, Matrix3};
 use crate::error::{Error, Warning};
 use crate::limit;
 use crate::mesh::GradientMesh;
@@ -17,7 +17,7 @@ use super::adaptive;
 use super::coverage::Line;
 use super::nearest::{NearestSegments, Segment};
 use super::outline::{boundary_loops, outline};
-use super::triangles::{snap, Triangle, SUBPIXEL};
+use super::triangles::{snap, Triangle, TriangleList, SUBPIXEL};
 use super::view::ToPixels;
 use super::{LayerInfo, LayerTimings, RenderOptions};
 
@@ -81,7 +81,7 @@ impl Bins {
 /// Everything needed to draw one layer.
 pub(crate) struct PreparedLayer {
     pub space: ColourSpace,
-    pub triangles: Vec<Triangle>,
+    pub triangles: TriangleList,
     pub triangle_bins: Bins,
     pub lines: Vec<Line>,
     pub line_bins: Bins,
@@ -264,6 +264,7 @@ fn measure(
             centre: &lim1[f],
             mids,
             boundary,
+            jacobians: None,
         };
         measure_quad(&quad, xf, size, space, min_quad, false)
     };
@@ -281,6 +282,27 @@ pub(super) struct QuadSamples<'a> {
     pub centre: &'a VertexData,
     pub mids: [&'a VertexData; 4],
     pub boundary: [bool; 4],
+    /// The derivatives of the working space to Lab at the centre and the midpoints, when the
+    /// caller has them: colour errors are then measured through them (see [`sample_error`]).
+    pub jacobians: Option<[&'a Matrix3; 5]>,
+}
+
+/// The colour error of `shown` against the limit `sample`: exact, or through the derivative
+/// `jacobian` of the working space to Lab at the sample. Errors worth measuring are a few Lab
+/// units, where the two agree to a fraction of a percent.
+fn sample_error(
+    space: ColourSpace,
+    sample: [f64; 4],
+    shown: [f64; 4],
+    jacobian: Option<&Matrix3>,
+) -> f64 {
+    let Some(j) = jacobian else {
+        return colour_error(space, sample, shown);
+    };
+    let d = [0, 1, 2].map(|k| sample[k] - shown[k]);
+    let lab = j.map(|row| row[0] * d[0] + row[1] * d[1] + row[2] * d[2]);
+    let colour = (lab[0] * lab[0] + lab[1] * lab[1] + lab[2] * lab[2]).sqrt();
+    colour.max(100.0 * (sample[3] - shown[3]).abs())
 }
 
 /// Measures one quad drawn as the triangles `(0, 1, 2)` and `(0, 2, 3)` (see [`measure`]).
@@ -327,19 +349,23 @@ pub(super) fn measure_quad(
         column && row
     };
     let counts = extent >= min_quad || (adaptive && holds_centre());
-    let check = |m: &mut Measure, sample: &VertexData, tri: usize| {
+    // `which`: 0 for the centre, 1 + k for the midpoint of side k.
+    let check = |m: &mut Measure, sample: &VertexData, which: usize, tri: usize| {
         if !counts {
             return;
         }
         let shown = interpolate(tris[tri].map(|i| p[i]), tris[tri].map(|i| c[i]), px(sample));
-        m.colour = m.colour.max(colour_error(space, attr(sample), shown));
+        let jacobian = q.jacobians.map(|j| j[which]);
+        m.colour = m
+            .colour
+            .max(sample_error(space, attr(sample), shown, jacobian));
     };
     // The quad's centre lies on the shared diagonal: both triangles.
-    check(&mut m, q.centre, 0);
-    check(&mut m, q.centre, 1);
+    check(&mut m, q.centre, 0, 0);
+    check(&mut m, q.centre, 0, 1);
     for k in 0..4 {
         let sample = q.mids[k];
-        check(&mut m, sample, if k < 2 { 0 } else { 1 });
+        check(&mut m, sample, 1 + k, if k < 2 { 0 } else { 1 });
         if q.boundary[k] {
             let (a, b) = (p[k], p[(k + 1) % 4]);
             let x = px(sample);
@@ -520,7 +546,7 @@ fn uniform_triangles(
     lim: &[VertexData],
     xf: &ToPixels,
     size: (i64, i64),
-) -> (Vec<Triangle>, Vec<Segment>) {
+) -> (TriangleList, Vec<Segment>) {
     let exact: Vec<[f64; 2]> = lim.iter().map(|d| xf.apply(d[0], d[1])).collect();
     let attr = |v: u32| {
         let d = &lim[v as usize];
@@ -535,11 +561,13 @@ fn uniform_triangles(
             })
             .collect()
     };
-    // Built in parallel, collected in face order.
-    let triangles: Vec<Triangle> = (0..t.face_count())
-        .into_par_iter()
-        .flat_map_iter(face_triangles)
-        .collect();
+    // Built in parallel, kept in face order.
+    let triangles = TriangleList::from_chunks(
+        (0..t.face_count())
+            .into_par_iter()
+            .map(face_triangles)
+            .collect(),
+    );
 
     // Boundary edges of the tessellation, for outline pixels no triangle reaches.
     let snappable = |p: [f64; 2]| snap(p[0]).is_some() && snap(p[1]).is_some();

@@ -395,12 +395,13 @@ pub fn render_document_into<P: OutputPixel>(
         [rgb[0] * a, rgb[1] * a, rgb[2] * a, a]
     });
     let start = Instant::now();
-    out.par_chunks_mut(4 * w * BAND).enumerate().for_each_init(
-        || Scratch::new(w),
-        |scratch, (band, chunk)| {
-            draw_band(band, chunk, &layers, opts, background, scratch);
-        },
-    );
+    out.par_chunks_mut(4 * w * BAND)
+        .enumerate()
+        .for_each(|(band, chunk)| {
+            Scratch::with(w, |scratch| {
+                draw_band(band, chunk, &layers, opts, background, scratch)
+            });
+        });
     info.timings.draw = start.elapsed();
     Ok(info)
 }
@@ -414,7 +415,28 @@ struct Scratch {
     colour: Vec<[f64; 4]>,
 }
 
+thread_local! {
+    /// Each thread's scratch, kept between bands and renders: allocating it per rayon job
+    /// (`for_each_init`) cost fresh pages, and so page faults, for every job.
+    static SCRATCH: std::cell::RefCell<Option<Scratch>> = const { std::cell::RefCell::new(None) };
+}
+
 impl Scratch {
+    /// Runs `f` with this thread's scratch for rows `w` pixels wide.
+    fn with<R>(w: usize, f: impl FnOnce(&mut Scratch) -> R) -> R {
+        SCRATCH.with(|cell| {
+            // A band never re-enters here (draw_band does not call into rayon), but stay safe
+            // if it ever does: a busy cell gets a scratch of its own.
+            let Ok(mut slot) = cell.try_borrow_mut() else {
+                return f(&mut Scratch::new(w));
+            };
+            if slot.as_ref().is_none_or(|s| s.coverage.len() != w) {
+                *slot = Some(Scratch::new(w));
+            }
+            f(slot.as_mut().expect("just filled"))
+        })
+    }
+
     fn new(w: usize) -> Self {
         Scratch {
             attributes: vec![[0.0; 4]; w * BAND],
@@ -451,8 +473,9 @@ fn draw_band<P: OutputPixel>(
         for r in 0..rows {
             s.covered[r * w + c0..r * w + c1].fill(false);
         }
+        let mut cursor = layer.triangles.cursor();
         for &ti in tris {
-            let t = &layer.triangles[ti as usize];
+            let t = cursor.get(ti as usize);
             let (j0, j1) = (t.rows.0.max(y0 as i64), t.rows.1.min((y0 + rows) as i64));
             for j in j0..j1 {
                 let (a, b) = t.span(j, w as i64);
