@@ -477,8 +477,7 @@ fn draw_band<P: OutputPixel>(
         for &ti in tris {
             let t = cursor.get(ti as usize);
             let (j0, j1) = (t.rows.0.max(y0 as i64), t.rows.1.min((y0 + rows) as i64));
-            for j in j0..j1 {
-                let (a, b) = t.span(j, w as i64);
+            t.for_each_span(j0..j1, w as i64, |j, a, b| {
                 let (a, b) = ((a as usize).max(c0), (b as usize).min(c1));
                 let r = j as usize - y0;
                 let y = j as f64 + 0.5;
@@ -486,7 +485,7 @@ fn draw_band<P: OutputPixel>(
                     s.attributes[r * w + i] = t.eval(i as f64 + 0.5, y);
                     s.covered[r * w + i] = true;
                 }
-            }
+            });
         }
         let stride = w + 2;
         s.accumulation[..stride * rows].fill(0.0);
@@ -541,28 +540,35 @@ fn draw_band<P: OutputPixel>(
 
     // Straight alpha, sRGB-encoded.
     let dither = opts.dither && P::DITHERED;
-    for (k, px) in out.chunks_exact_mut(4).enumerate() {
-        let c = colour[k];
-        let a = c[3].clamp(0.0, 1.0);
-        let mut rgba = [0.0f64; 4];
-        if a > 0.0 {
-            for ch in 0..3 {
-                let v = (c[ch] / c[3]).clamp(0.0, 1.0);
-                rgba[ch] = match opts.blend {
-                    BlendSpace::Srgb => v,
-                    BlendSpace::Linear => gamut::srgb_encode_fast(v),
-                };
+    for (r, (row_out, row_colour)) in out
+        .chunks_exact_mut(4 * w)
+        .zip(colour.chunks_exact(w))
+        .enumerate()
+    {
+        let y = (y0 + r) as u32;
+        for (x, (px, c)) in row_out.chunks_exact_mut(4).zip(row_colour).enumerate() {
+            let a = c[3].clamp(0.0, 1.0);
+            let mut rgba = [0.0f64; 4];
+            if a > 0.0 {
+                for ch in 0..3 {
+                    // Opaque pixels (most of them) skip the division, which would be exact.
+                    let v = if c[3] == 1.0 { c[ch] } else { c[ch] / c[3] };
+                    let v = v.clamp(0.0, 1.0);
+                    rgba[ch] = match opts.blend {
+                        BlendSpace::Srgb => v,
+                        BlendSpace::Linear => gamut::srgb_encode_fast(v),
+                    };
+                }
+                rgba[3] = a;
             }
-            rgba[3] = a;
-        }
-        let (x, y) = ((k % w) as u32, (y0 + k / w) as u32);
-        for ch in 0..4 {
-            let noise = if dither {
-                output::dither_noise(x, y, ch as u32)
-            } else {
-                0.0
-            };
-            px[ch] = P::encode(rgba[ch] as f32, noise);
+            for ch in 0..4 {
+                let noise = if dither {
+                    output::dither_noise(x as u32, y, ch as u32)
+                } else {
+                    0.0
+                };
+                px[ch] = P::encode(rgba[ch] as f32, noise);
+            }
         }
     }
 }

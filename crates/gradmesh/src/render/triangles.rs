@@ -228,22 +228,44 @@ impl Triangle {
 
     /// The columns `[start, end)` of row `j` whose pixel centres lie inside, clipped to
     /// `0..width`.
+    #[cfg(test)]
     pub fn span(&self, j: i64, width: i64) -> (i64, i64) {
+        self.span_with(&self.edges(), j, width)
+    }
+
+    /// Calls `f(j, start, end)` with the [`Triangle::span`] of each row `j` in `rows`, finding
+    /// the edges once.
+    #[inline]
+    pub fn for_each_span(
+        &self,
+        rows: std::ops::Range<i64>,
+        width: i64,
+        mut f: impl FnMut(i64, i64, i64),
+    ) {
+        let edges = self.edges();
+        for j in rows {
+            let (a, b) = self.span_with(&edges, j, width);
+            f(j, a, b);
+        }
+    }
+
+    #[inline]
+    fn span_with(&self, edges: &[Edge; 3], j: i64, width: i64) -> (i64, i64) {
         if self.small && j.abs() < SMALL_ROWS {
-            self.span_small(j, width)
+            Self::span_small(edges, j, width)
         } else {
-            self.span_wide(j, width)
+            Self::span_wide(edges, j, width)
         }
     }
 
     /// [`Triangle::span`] in 64-bit integers: exact when the vertices lie within [`SMALL`] and
     /// the row within [`SMALL_ROWS`] (every product stays under 2^55), and several times faster
     /// than 128-bit division. Same arithmetic, same answers.
-    fn span_small(&self, j: i64, width: i64) -> (i64, i64) {
+    fn span_small(edges: &[Edge; 3], j: i64, width: i64) -> (i64, i64) {
         let half = SUBPIXEL / 2;
         let ry = j * SUBPIXEL + half;
         let (mut start, mut end) = (0i64, width);
-        for e in self.edges() {
+        for e in edges {
             let (px, py) = (e.p[0], e.p[1]);
             let (dx, dy) = (e.d[0], e.d[1]);
             let k = dx * (ry - py) - dy * (half - px);
@@ -277,11 +299,11 @@ impl Triangle {
     }
 
     /// [`Triangle::span`] in 128-bit integers, for any snapped coordinates.
-    fn span_wide(&self, j: i64, width: i64) -> (i64, i64) {
+    fn span_wide(edges: &[Edge; 3], j: i64, width: i64) -> (i64, i64) {
         let half = (SUBPIXEL / 2) as i128;
         let ry = j as i128 * SUBPIXEL as i128 + half;
         let (mut start, mut end) = (0i128, width as i128);
-        for e in self.edges() {
+        for e in edges {
             let (px, py) = (e.p[0] as i128, e.p[1] as i128);
             let (dx, dy) = (e.d[0] as i128, e.d[1] as i128);
             // E(i) = dx (ry - py) - dy (256 i + 128 - px) = k - m i.
@@ -487,7 +509,11 @@ mod tests {
             };
             assert!(t.small);
             for j in t.rows.0 - 1..=t.rows.1 {
-                assert_eq!(t.span_small(j, 600), t.span_wide(j, 600));
+                let e = t.edges();
+                assert_eq!(
+                    Triangle::span_small(&e, j, 600),
+                    Triangle::span_wide(&e, j, 600)
+                );
             }
         }
     }
