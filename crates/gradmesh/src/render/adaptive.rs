@@ -1,6 +1,7 @@
 //! The fast path's tessellation: each face of a low all-quad level gets its own grid density.
 //!
-//! 1. **Density.** Each face of level [`BASE_LEVEL`] is evaluated on grids of `1, 2, 4, ..`
+//! 1. **Density.** Each face of the base level ([`BASE_LEVEL`], shallower for meshes dense for
+//!    the image: see [`base_level`]) is evaluated on grids of `1, 2, 4, ..`
 //!    cells a side ([`patches`](super::patches): a B-spline patch where the face is regular,
 //!    local refinement elsewhere) until its cells pass the same measure as the uniform path's
 //!    quads (colour at cell and side centres against the triangles, cell size, outline). A face
@@ -36,6 +37,27 @@ use super::view::ToPixels;
 pub(crate) const BASE_LEVEL: usize = 3;
 /// The deepest base level tried when semi-sharp features still touch the outline.
 const DEEPEST_BASE_LEVEL: usize = 4;
+/// Dense meshes start shallower when level [`BASE_LEVEL`] would have fewer pixels than this
+/// per face: building every face's patch then costs more than the pixels, and each face's own
+/// grid refines it where the picture needs it anyway.
+const MIN_BASE_FACE_PIXELS: usize = 64;
+
+/// The base level for a layer drawn into `size` pixels: [`BASE_LEVEL`], or 2 when its faces
+/// would be too many for the image, or 1 (when the ternary step made only quads) when even
+/// level 2's would.
+fn base_level(refinement: &Refinement, size: (i64, i64)) -> usize {
+    let pixels = (size.0.max(0) as usize).saturating_mul(size.1.max(0) as usize);
+    // Level 2 is all quads, so level 3 has four times its faces.
+    let faces2 = refinement.topology(2).face_count();
+    let too_many = |faces: usize| faces.saturating_mul(MIN_BASE_FACE_PIXELS) > pixels;
+    if too_many(faces2) && refinement.topology(1).is_all_quads() {
+        1
+    } else if too_many(4 * faces2) {
+        2
+    } else {
+        BASE_LEVEL
+    }
+}
 
 /// What the fast path produced for one layer.
 pub(super) struct Tessellation {
@@ -258,7 +280,7 @@ pub(super) fn tessellate(
 ) -> Option<Tessellation> {
     // Faces refine on their own from the base level with bare stencils: it must lie below the
     // rings of the deepest multi-resolution edit.
-    let mut k0 = BASE_LEVEL.max(refinement.base().edits.deepest_level() + 1);
+    let mut k0 = base_level(refinement, size).max(refinement.base().edits.deepest_level() + 1);
     loop {
         while data.levels.len() <= k0 {
             let j = data.levels.len() - 1;

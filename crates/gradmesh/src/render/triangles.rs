@@ -233,7 +233,7 @@ impl Triangle {
         self.span_with(&self.edges(), j, width)
     }
 
-    /// Calls `f(j, start, end)` with the [`Triangle::span`] of each row `j` in `rows`, finding
+    /// Calls `f(j, start, end)` with the columns inside for each row `j` in `rows`, finding
     /// the edges once.
     #[inline]
     pub fn for_each_span(
@@ -258,7 +258,7 @@ impl Triangle {
         }
     }
 
-    /// [`Triangle::span`] in 64-bit integers: exact when the vertices lie within [`SMALL`] and
+    /// A row's span in 64-bit integers: exact when the vertices lie within [`SMALL`] and
     /// the row within [`SMALL_ROWS`] (every product stays under 2^55), and several times faster
     /// than 128-bit division. Same arithmetic, same answers.
     fn span_small(edges: &[Edge; 3], j: i64, width: i64) -> (i64, i64) {
@@ -298,7 +298,7 @@ impl Triangle {
         }
     }
 
-    /// [`Triangle::span`] in 128-bit integers, for any snapped coordinates.
+    /// A row's span in 128-bit integers, for any snapped coordinates.
     fn span_wide(edges: &[Edge; 3], j: i64, width: i64) -> (i64, i64) {
         let half = (SUBPIXEL / 2) as i128;
         let ry = j as i128 * SUBPIXEL as i128 + half;
