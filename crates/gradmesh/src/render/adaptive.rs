@@ -40,7 +40,7 @@ const DEEPEST_BASE_LEVEL: usize = 4;
 /// Dense meshes start shallower when level [`BASE_LEVEL`] would have fewer pixels than this
 /// per face: building every face's patch then costs more than the pixels, and each face's own
 /// grid refines it where the picture needs it anyway.
-const MIN_BASE_FACE_PIXELS: usize = 64;
+const MIN_BASE_FACE_PIXELS: usize = 16;
 
 /// The base level for a layer drawn into `size` pixels: [`BASE_LEVEL`], or 2 when its faces
 /// would be too many for the image, or 1 (when the ternary step made only quads) when even
