@@ -421,15 +421,23 @@ thread_local! {
     static SCRATCH: std::cell::RefCell<Option<Scratch>> = const { std::cell::RefCell::new(None) };
 }
 
+/// The widest rows whose scratch a thread keeps between bands and renders.
+const KEEP_SCRATCH_MAX_WIDTH: usize = 8192;
+
 impl Scratch {
     /// Runs `f` with this thread's scratch for rows `w` pixels wide.
     fn with<R>(w: usize, f: impl FnOnce(&mut Scratch) -> R) -> R {
         SCRATCH.with(|cell| {
             // A band never re-enters here (draw_band does not call into rayon), but stay safe
             // if it ever does: a busy cell gets a scratch of its own.
+            // Very wide images get a scratch for the band only: a thread keeps at most about
+            // 7 MB between renders.
             let Ok(mut slot) = cell.try_borrow_mut() else {
                 return f(&mut Scratch::new(w));
             };
+            if w > KEEP_SCRATCH_MAX_WIDTH {
+                return f(&mut Scratch::new(w));
+            }
             if slot.as_ref().is_none_or(|s| s.coverage.len() != w) {
                 *slot = Some(Scratch::new(w));
             }
