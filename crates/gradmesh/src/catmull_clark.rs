@@ -74,6 +74,18 @@ impl Level {
             .collect()
     }
 
+    /// The sharpness of the child edge that is the half of edge `e` at its end `v`. Only
+    /// Chaikin creasing looks at the other edges around `v`.
+    pub fn half_edge_sharpness(&self, e: u32, v: u32) -> f64 {
+        let s = self.edge_sharpness[e as usize];
+        match self.creasing {
+            CreasingMethod::Uniform => rules::decrement_sharpness(s),
+            CreasingMethod::Chaikin => {
+                rules::child_edge_sharpness(self.creasing, s, &self.incident_sharpness(v as usize))
+            }
+        }
+    }
+
     /// The rule that applies at vertex `v` at this level.
     pub fn vertex_rule(&self, v: usize) -> VertexRule {
         let sharp = self
@@ -311,18 +323,6 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
         child_vertex_sharpness[vertex_point(v as u32) as usize] =
             rules::decrement_sharpness(parent.vertex_sharpness[v]);
     }
-    // Only Chaikin creasing looks at the other edges around the vertex.
-    let half_sharpness = |e: u32, v: u32| -> f64 {
-        let s = parent.edge_sharpness[e as usize];
-        match parent.creasing {
-            CreasingMethod::Uniform => rules::decrement_sharpness(s),
-            CreasingMethod::Chaikin => rules::child_edge_sharpness(
-                parent.creasing,
-                s,
-                &parent.incident_sharpness(v as usize),
-            ),
-        }
-    };
     let mut child_edge_sharpness = vec![0.0; child_topology.edge_count()];
     for f in 0..nf {
         let fv = t.face_vertices(f);
@@ -331,9 +331,10 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
         let base = t.face_offset(f);
         for i in 0..n {
             let child_edges = child_topology.face_edges(base + i);
-            child_edge_sharpness[child_edges[0] as usize] = half_sharpness(fe[i], fv[i]);
+            child_edge_sharpness[child_edges[0] as usize] =
+                parent.half_edge_sharpness(fe[i], fv[i]);
             child_edge_sharpness[child_edges[3] as usize] =
-                half_sharpness(fe[(i + n - 1) % n], fv[i]);
+                parent.half_edge_sharpness(fe[(i + n - 1) % n], fv[i]);
         }
     }
     let child = Level {
@@ -389,18 +390,6 @@ fn build_range(
 fn stencil_terms(parent: &Level) -> impl Fn(usize, &mut Vec<(u32, f64)>) + Sync + '_ {
     let t = &parent.topology;
     let (nf, ne) = (t.face_count(), t.edge_count());
-    // Only Chaikin creasing looks at the other edges around the vertex.
-    let half_sharpness = move |e: u32, v: u32| -> f64 {
-        let s = parent.edge_sharpness[e as usize];
-        match parent.creasing {
-            CreasingMethod::Uniform => rules::decrement_sharpness(s),
-            CreasingMethod::Chaikin => rules::child_edge_sharpness(
-                parent.creasing,
-                s,
-                &parent.incident_sharpness(v as usize),
-            ),
-        }
-    };
     let face_stencil = move |f: usize, terms: &mut Vec<(u32, f64)>| {
         face_centroid_terms(t, f, 1.0, terms);
     };
@@ -430,7 +419,7 @@ fn stencil_terms(parent: &Level) -> impl Fn(usize, &mut Vec<(u32, f64)>) + Sync 
         let child_sharp_count = t
             .vertex_edges(v)
             .iter()
-            .filter(|&&e| rules::is_sharp(half_sharpness(e, v as u32)))
+            .filter(|&&e| rules::is_sharp(parent.half_edge_sharpness(e, v as u32)))
             .count();
         let child_rule = rules::vertex_rule(child_vertex_sharpness, child_sharp_count);
         let parent_sharp =
@@ -443,7 +432,7 @@ fn stencil_terms(parent: &Level) -> impl Fn(usize, &mut Vec<(u32, f64)>) + Sync 
             let child_incident: Vec<f64> = t
                 .vertex_edges(v)
                 .iter()
-                .map(|&e| half_sharpness(e, v as u32))
+                .map(|&e| parent.half_edge_sharpness(e, v as u32))
                 .collect();
             let child_sharp = |k: usize| rules::is_sharp(child_incident[k]);
             let w = rules::fractional_weight(
