@@ -640,6 +640,60 @@ fn opacity_composites_in_the_blend_space() {
     );
 }
 
+/// Layers drawn together equal each layer drawn alone and composited back to front (source-over
+/// in sRGB-encoded values), with partial opacity, anti-aliased edges, an opaque layer hiding part
+/// of those below it, and a background under all.
+#[test]
+fn layers_composite_like_separate_images() {
+    let star_layer = |c: Point, r: f64, opacity: f64| {
+        let mut m = star(c, r);
+        m.points.iter_mut().for_each(|p| p.opacity = opacity);
+        m
+    };
+    let layers = vec![
+        grid(3, 3, [5.0, 5.0, 95.0, 95.0], 0.3, soft_colour),
+        star_layer(Point::new(40.0, 45.0), 35.0, 0.6),
+        star_layer(Point::new(60.0, 55.0), 30.0, 1.0),
+        star_layer(Point::new(50.0, 50.0), 20.0, 0.3),
+    ];
+    let mut opts = RenderOptions::new(120, 120, View::new(0.0, 0.0, 100.0, 100.0));
+    let bg = [0.2, 0.4, 0.9, 0.7];
+    opts.background = Some(bg);
+    let together = render_document(&doc(layers.clone()), &opts).unwrap();
+    opts.background = None;
+    let alone: Vec<Image> = layers
+        .iter()
+        .map(|m| render_document(&doc(vec![m.clone()]), &opts).unwrap())
+        .collect();
+    let mut opaque_hidden = 0;
+    for y in 0..120 {
+        for x in 0..120 {
+            // Premultiplied source-over, bottom first.
+            let mut acc = [bg[0] * bg[3], bg[1] * bg[3], bg[2] * bg[3], bg[3]];
+            for img in &alone {
+                let p = img.pixel(x, y).map(|v| v as f64);
+                for c in 0..3 {
+                    acc[c] = p[c] * p[3] + acc[c] * (1.0 - p[3]);
+                }
+                acc[3] = p[3] + acc[3] * (1.0 - p[3]);
+            }
+            if alone[2].pixel(x, y)[3] == 1.0 && alone[1].pixel(x, y)[3] > 0.0 {
+                opaque_hidden += 1;
+            }
+            let got = together.pixel(x, y);
+            assert!((got[3] as f64 - acc[3]).abs() < 1e-5, "({x}, {y}): {got:?}");
+            for c in 0..3 {
+                let expect = acc[c] / acc[3];
+                assert!(
+                    (got[c] as f64 - expect).abs() < 1e-4,
+                    "({x}, {y}): {got:?} against {expect}"
+                );
+            }
+        }
+    }
+    assert!(opaque_hidden > 500, "{opaque_hidden}");
+}
+
 /// Interpolating in another space changes the colours between control points, not at them.
 #[test]
 fn colour_space_override_and_gamut_options() {

@@ -37,7 +37,10 @@ const MIN_QUAD_PX: f64 = 1.0;
 /// The fast path holds each face's measured colour error to this fraction of the tolerance: the
 /// measure samples cell and side centres only, and each face now stops right at the threshold
 /// instead of at the level the worst spot of the layer asks for (the uniform path's margin).
-const ADAPTIVE_COLOUR_MARGIN: f64 = 0.5;
+/// Half (before 2026-12) cost about twice the cells for the same pictures: against the
+/// reference mode the worst pixel of every example and real file stayed below 0.3 CIEDE2000
+/// but one (0.43, on a one-pixel colour crease), the worst mean 0.022 (limits 0.5 and 0.05).
+const ADAPTIVE_COLOUR_MARGIN: f64 = 0.75;
 /// Flattening tolerance of the outline (pixels): coverage error at most this per pixel.
 const OUTLINE_TOLERANCE_PX: f64 = 0.002;
 const REFERENCE_OUTLINE_TOLERANCE_PX: f64 = 0.0002;

@@ -11,8 +11,8 @@
 //!    plane, so the non-affine map from mesh to plane (usually the larger term) is included.
 //!    - **Fast path (feature-adaptive).** The mesh is refined to level 3 only (all quads,
 //!      extraordinary vertices isolated). Each face of that level gets its own grid density,
-//!      doubled until its cells pass the measure (colour held to half the tolerance, since each
-//!      face now stops right at it). A face whose neighbourhood is regular (valence-4 interior,
+//!      doubled until its cells pass the measure (colour held to three quarters of the
+//!      tolerance, since each face now stops right at it). A face whose neighbourhood is regular (valence-4 interior,
 //!      valence-3 boundary or corner vertices, no sharpness but the boundary's) is exactly a
 //!      uniform bicubic B-spline patch in position, colour and opacity, with phantom points
 //!      beyond a boundary, and is evaluated directly; any other face (extraordinary vertex,
@@ -50,7 +50,9 @@
 //!    boundary. Alpha is coverage times the interpolated opacity.
 //! 4. **Colour.** Working space to linear sRGB, [`GamutMapping`] (default: chroma reduction in
 //!    Oklch), sRGB transfer function; layers composited source-over with premultiplied alpha in
-//!    the [`BlendSpace`] (default: sRGB-encoded, as SVG and image viewers do).
+//!    the [`BlendSpace`] (default: sRGB-encoded, as SVG and image viewers do). The bands
+//!    composite front to back (the same sum, taken from the top layer down), so a pixel an
+//!    opaque layer already covers is not evaluated again for the layers beneath.
 //!
 //! Rows are split into bands of 16 drawn in parallel with rayon; every band does the same
 //! arithmetic whichever thread runs it, so the output does not depend on the thread count.
@@ -469,9 +471,15 @@ fn draw_band<P: OutputPixel>(
     let y0 = band * BAND;
     let rows = out.len() / (4 * w);
     let colour = &mut s.colour[..w * rows];
-    colour.fill(background.unwrap_or([0.0; 4]));
+    colour.fill([0.0; 4]);
 
-    for layer in layers {
+    // Front to back ("under"): a pixel that is already opaque is not evaluated again, and the
+    // band stops once all of its pixels are.
+    let mut opaque = 0usize;
+    for layer in layers.iter().rev() {
+        if opaque == w * rows {
+            break;
+        }
         let tris = layer.triangle_bins.get(band);
         let lines = layer.line_bins.get(band);
         if lines.is_empty() {
@@ -490,8 +498,11 @@ fn draw_band<P: OutputPixel>(
                 let r = j as usize - y0;
                 let y = j as f64 + 0.5;
                 for i in a..b {
-                    s.attributes[r * w + i] = t.eval(i as f64 + 0.5, y);
-                    s.covered[r * w + i] = true;
+                    let k = r * w + i;
+                    if colour[k][3] < 1.0 {
+                        s.attributes[k] = t.eval(i as f64 + 0.5, y);
+                        s.covered[k] = true;
+                    }
                 }
             });
         }
@@ -514,10 +525,10 @@ fn draw_band<P: OutputPixel>(
             let y = (y0 + r) as f64 + 0.5;
             for i in c0..c1 {
                 let cov = s.coverage[i];
-                if cov == 0.0 {
+                let k = r * w + i;
+                if cov == 0.0 || colour[k][3] >= 1.0 {
                     continue;
                 }
-                let k = r * w + i;
                 let attr = if s.covered[k] {
                     s.attributes[k]
                 } else {
@@ -537,11 +548,25 @@ fn draw_band<P: OutputPixel>(
                     opts.blend,
                 );
                 let dst = &mut colour[k];
-                let keep = 1.0 - alpha;
+                let weight = alpha * (1.0 - dst[3]);
                 for c in 0..3 {
-                    dst[c] = rgb[c] * alpha + dst[c] * keep;
+                    dst[c] += rgb[c] * weight;
                 }
-                dst[3] = alpha + dst[3] * keep;
+                // a + (1 - a) is 1, but not always in floating point.
+                dst[3] = if alpha >= 1.0 { 1.0 } else { dst[3] + weight };
+                if dst[3] >= 1.0 {
+                    opaque += 1;
+                }
+            }
+        }
+    }
+    if let Some(bg) = background {
+        for dst in colour.iter_mut() {
+            let keep = 1.0 - dst[3];
+            if keep > 0.0 {
+                for c in 0..4 {
+                    dst[c] += bg[c] * keep;
+                }
             }
         }
     }
@@ -569,13 +594,13 @@ fn draw_band<P: OutputPixel>(
                 }
                 rgba[3] = a;
             }
+            let noise = if dither {
+                output::dither_noise(x as u32, y)
+            } else {
+                [0.0; 4]
+            };
             for ch in 0..4 {
-                let noise = if dither {
-                    output::dither_noise(x as u32, y, ch as u32)
-                } else {
-                    0.0
-                };
-                px[ch] = P::encode(rgba[ch] as f32, noise);
+                px[ch] = P::encode(rgba[ch] as f32, noise[ch]);
             }
         }
     }

@@ -45,25 +45,19 @@ impl OutputPixel for u8 {
     }
 }
 
-/// Deterministic triangular (TPDF) dither noise in `-1..1` for channel `c` of pixel `(x, y)`:
-/// the sum of two uniform hashes, so quantisation error is independent of the signal and
-/// smooth gradients show no bands. No pattern repeats at a small period, unlike a Bayer matrix.
-pub(crate) fn dither_noise(x: u32, y: u32, c: u32) -> f32 {
-    let h = |seed: u32| -> f32 {
-        let mut v = x
-            .wrapping_mul(0x9E37_79B1)
-            .wrapping_add(y.wrapping_mul(0x85EB_CA77))
-            .wrapping_add(c.wrapping_mul(0xC2B2_AE3D))
-            .wrapping_add(seed);
-        // A 32-bit finaliser (lowbias32).
-        v ^= v >> 16;
-        v = v.wrapping_mul(0x7FEB_352D);
-        v ^= v >> 15;
-        v = v.wrapping_mul(0x846C_A68B);
-        v ^= v >> 16;
-        (v >> 8) as f32 / (1u32 << 24) as f32
-    };
-    h(0x68E3_1DA4) + h(0xB529_7A4D) - 1.0
+/// Deterministic triangular (TPDF) dither noise in `-1..1` for the four channels of pixel
+/// `(x, y)`: each the sum of two uniform bytes of one 64-bit hash of the position, so
+/// quantisation error is independent of the signal and smooth gradients show no bands. No
+/// pattern repeats at a small period, unlike a Bayer matrix. One hash serves the whole pixel
+/// (eight bytes of noise at 1/256 of an output step are plenty).
+pub(crate) fn dither_noise(x: u32, y: u32) -> [f32; 4] {
+    // splitmix64's finaliser of the position.
+    let mut v = ((y as u64) << 32 | x as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+    v = (v ^ (v >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    v = (v ^ (v >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    v ^= v >> 31;
+    let b = v.to_le_bytes();
+    [0, 1, 2, 3].map(|c| (b[2 * c] as f32 + b[2 * c + 1] as f32 + 1.0) / 256.0 - 1.0)
 }
 
 /// An RGBA image with `f32` channels: straight (non-premultiplied) alpha, sRGB-encoded colour
@@ -112,20 +106,28 @@ impl Image {
     fn quantise<P: OutputPixel>(&self, dither: bool) -> Vec<P> {
         use rayon::prelude::*;
         let w = self.width as usize;
-        // Each channel depends only on its own value and position: any split gives the same.
-        self.data
-            .par_iter()
+        let mut out = vec![P::encode(0.0, 0.0); self.data.len()];
+        if w == 0 {
+            return out;
+        }
+        // Each pixel depends only on its own values and position: any split gives the same.
+        out.par_chunks_mut(4 * w)
+            .zip(self.data.par_chunks(4 * w))
             .enumerate()
-            .map(|(i, &v)| {
-                let noise = if dither && P::DITHERED {
-                    let p = i / 4;
-                    dither_noise((p % w) as u32, (p / w) as u32, (i % 4) as u32)
-                } else {
-                    0.0
-                };
-                P::encode(v, noise)
-            })
-            .collect()
+            .for_each(|(y, (row_out, row))| {
+                let pixels = row_out.chunks_exact_mut(4).zip(row.chunks_exact(4));
+                for (x, (px, v)) in pixels.enumerate() {
+                    let noise = if dither && P::DITHERED {
+                        dither_noise(x as u32, y as u32)
+                    } else {
+                        [0.0; 4]
+                    };
+                    for c in 0..4 {
+                        px[c] = P::encode(v[c], noise[c]);
+                    }
+                }
+            });
+        out
     }
 }
 
@@ -181,16 +183,33 @@ mod tests {
         let mut inner = 0;
         let n = 200_000;
         for i in 0..n {
-            let v = dither_noise(i % 512, i / 512, 1);
-            assert!((-1.0..1.0).contains(&v));
-            sum += v as f64;
-            if v.abs() < 0.5 {
-                inner += 1;
+            for v in dither_noise(i % 512, i / 512) {
+                assert!((-1.0..1.0).contains(&v));
+                sum += v as f64;
+                if v.abs() < 0.5 {
+                    inner += 1;
+                }
             }
         }
-        assert!((sum / n as f64).abs() < 0.01);
+        let n = 4.0 * n as f64;
+        assert!((sum / n).abs() < 0.01);
         // A triangular density puts 3/4 of its mass within half the range.
-        assert!((inner as f64 / n as f64 - 0.75).abs() < 0.01);
+        assert!((inner as f64 / n - 0.75).abs() < 0.01);
+    }
+
+    #[test]
+    fn noise_is_uncorrelated_between_channels_and_neighbours() {
+        let (mut channels, mut neighbours, mut power) = (0.0, 0.0, 0.0);
+        for y in 0..256 {
+            for x in 0..256 {
+                let (v, right) = (dither_noise(x, y), dither_noise(x + 1, y));
+                channels += (v[0] * v[1]) as f64;
+                neighbours += (v[2] * right[2]) as f64;
+                power += (v[0] * v[0]) as f64;
+            }
+        }
+        assert!((channels / power).abs() < 0.02, "{}", channels / power);
+        assert!((neighbours / power).abs() < 0.02, "{}", neighbours / power);
     }
 
     #[test]
