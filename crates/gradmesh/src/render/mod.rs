@@ -503,15 +503,14 @@ fn draw_band<P: OutputPixel>(
             let (j0, j1) = (t.rows.0.max(y0 as i64), t.rows.1.min((y0 + rows) as i64));
             t.for_each_span(j0..j1, w as i64, |j, a, b| {
                 let (a, b) = ((a as usize).max(c0), (b as usize).min(c1));
-                let r = j as usize - y0;
-                let y = j as f64 + 0.5;
-                for i in a..b {
-                    let k = r * w + i;
-                    if !s.opaque[k] {
-                        s.attributes[k] = t.eval(i as f64 + 0.5, y);
-                        s.covered[k] = true;
-                    }
+                if a >= b {
+                    return;
                 }
+                let row = (j as usize - y0) * w;
+                let y = j as f64 + 0.5;
+                let span = row + a..row + b;
+                t.fill_row(y, a as f64 + 0.5, &mut s.attributes[span.clone()]);
+                s.covered[span].fill(true);
             });
         }
         let stride = w + 2;
@@ -582,35 +581,54 @@ fn draw_band<P: OutputPixel>(
 
     // Straight alpha, sRGB-encoded.
     let dither = opts.dither && P::DITHERED;
+    let linear = opts.blend == BlendSpace::Linear;
     for (r, (row_out, row_colour)) in out
         .chunks_exact_mut(4 * w)
         .zip(colour.chunks_exact(w))
         .enumerate()
     {
         let y = (y0 + r) as u32;
-        for (x, (px, c)) in row_out.chunks_exact_mut(4).zip(row_colour).enumerate() {
-            let a = c[3].clamp(0.0, 1.0);
-            let mut rgba = [0.0f64; 4];
-            if a > 0.0 {
-                for ch in 0..3 {
-                    // Opaque pixels (most of them) skip the division, which would be exact.
-                    let v = if c[3] == 1.0 { c[ch] } else { c[ch] / c[3] };
-                    let v = v.clamp(0.0, 1.0);
-                    rgba[ch] = match opts.blend {
-                        BlendSpace::Srgb => v,
-                        BlendSpace::Linear => gamut::srgb_encode_fast(v),
-                    };
+        let pixels = row_out.chunks_exact_mut(4).zip(row_colour);
+        if dither {
+            for (x, (px, c)) in pixels.enumerate() {
+                let rgba = straight_srgb(c, linear);
+                let noise = output::dither_noise(x as u32, y);
+                for ch in 0..4 {
+                    px[ch] = P::encode(rgba[ch], noise[ch]);
                 }
-                rgba[3] = a;
             }
-            let noise = if dither {
-                output::dither_noise(x as u32, y)
-            } else {
-                [0.0; 4]
-            };
-            for ch in 0..4 {
-                px[ch] = P::encode(rgba[ch] as f32, noise[ch]);
+        } else {
+            for (px, c) in pixels {
+                let rgba = straight_srgb(c, linear);
+                for ch in 0..4 {
+                    px[ch] = P::encode(rgba[ch], 0.0);
+                }
             }
         }
     }
+}
+
+/// A premultiplied colour of the blend space as straight-alpha, sRGB-encoded channels.
+#[inline]
+fn straight_srgb(c: &[f64; 4], linear: bool) -> [f32; 4] {
+    let a = c[3];
+    if a.is_nan() || a <= 0.0 {
+        return [0.0; 4];
+    }
+    // Opaque pixels (most of them) skip the division, which would be exact.
+    let opaque = a >= 1.0;
+    let mut out = [1.0f32; 4];
+    for ch in 0..3 {
+        let v = if opaque { c[ch] } else { c[ch] / a };
+        let v = v.clamp(0.0, 1.0);
+        out[ch] = if linear {
+            gamut::srgb_encode_fast(v)
+        } else {
+            v
+        } as f32;
+    }
+    if !opaque {
+        out[3] = a as f32;
+    }
+    out
 }

@@ -338,11 +338,19 @@ impl Triangle {
     }
 
     /// The attributes at pixel coordinates `(x, y)`.
-    #[inline]
+    #[cfg(test)]
     pub fn eval(&self, x: f64, y: f64) -> [f32; 4] {
-        let mut out = [0.0f32; 4];
-        for k in 0..4 {
-            out[k] = (self.base[k] + self.gx[k] * x + self.gy[k] * y) as f32;
+        self.fill_row(y, x, &mut [[0.0; 4]])[0]
+    }
+
+    /// Writes the attributes at the pixel centres `x0, x0 + 1, ..` of row `y` into `out`:
+    /// the row's constant part once, then one multiply-add per attribute and pixel.
+    #[inline]
+    pub fn fill_row<'a>(&self, y: f64, x0: f64, out: &'a mut [[f32; 4]]) -> &'a [[f32; 4]] {
+        let row: [f64; 4] = std::array::from_fn(|k| self.base[k] + self.gy[k] * y);
+        for (n, o) in out.iter_mut().enumerate() {
+            let x = x0 + n as f64;
+            *o = std::array::from_fn(|k| (row[k] + self.gx[k] * x) as f32);
         }
         out
     }
