@@ -137,7 +137,7 @@ pub(super) struct Thresholds {
 }
 
 impl Thresholds {
-    fn new(opts: &RenderOptions, space: ColourSpace) -> Thresholds {
+    pub(super) fn new(opts: &RenderOptions, space: ColourSpace) -> Thresholds {
         Thresholds {
             quad: opts.max_quad_px,
             colour: ADAPTIVE_COLOUR_MARGIN * opts.colour_tolerance,
