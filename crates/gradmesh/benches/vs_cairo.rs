@@ -139,6 +139,43 @@ fn bench(c: &mut Criterion) {
         })
     });
     g.finish();
+
+    // The ratios the issue asks for, from medians of the same three jobs run back to back
+    // (criterion's own figures above are the careful ones).
+    let median = |f: &mut dyn FnMut()| {
+        let mut t: Vec<f64> = (0..15)
+            .map(|_| {
+                let start = std::time::Instant::now();
+                f();
+                start.elapsed().as_secs_f64()
+            })
+            .collect();
+        t.sort_by(f64::total_cmp);
+        t[t.len() / 2]
+    };
+    let ours = median(&mut || {
+        render_document_into(black_box(&doc), &opts, &mut buffer).unwrap();
+    });
+    let cairo = median(&mut || {
+        let cr = Context::new(&surface).unwrap();
+        cr.set_source(black_box(&mesh)).unwrap();
+        cr.paint().unwrap();
+    });
+    let floor = median(&mut || {
+        for px in buffer.chunks_exact_mut(4) {
+            px.copy_from_slice(black_box(&[200, 100, 50, 255]));
+        }
+    });
+    println!(
+        "medians of 15: gradmesh {:.1} ms, cairo {:.1} ms, floor {:.2} ms; \
+         gradmesh / cairo = {:.2} (target 0.25), gradmesh / floor = {:.0}, cairo / floor = {:.0}",
+        ours * 1e3,
+        cairo * 1e3,
+        floor * 1e3,
+        ours / cairo,
+        ours / floor,
+        cairo / floor
+    );
 }
 
 criterion_group!(benches, bench);
