@@ -525,9 +525,11 @@ fn draw_band<P: OutputPixel>(
             );
         }
         for r in 0..rows {
+            // Left of the layer's columns the accumulation is all zeros, so its prefix sums
+            // may start there.
             coverage::resolve_row(
-                &s.accumulation[r * stride..(r + 1) * stride],
-                &mut s.coverage,
+                &s.accumulation[r * stride + c0..r * stride + c1],
+                &mut s.coverage[c0..c1],
             );
             let y = (y0 + r) as f64 + 0.5;
             for i in c0..c1 {
