@@ -442,3 +442,30 @@ fn edits_are_listed_and_applied_by_refine() {
     let out = gradmesh(&["edits", s(&plain_path)]);
     assert!(String::from_utf8(out.stdout).unwrap().contains("no edits"));
 }
+
+/// `render` draws straight into 8- or 16-bit pixels (no `f32` image) unless outlines go on
+/// top: every way gives the bytes the library's image path encodes.
+#[test]
+fn render_writes_the_image_paths_pixels() {
+    use gradmesh::render::{encode_png, render_image, RenderOptions, View};
+    let dir = tempfile::tempdir().unwrap();
+    let input = realdata().join("Glasses.off");
+    let doc = gradmesh::formats::read_path(&input).unwrap();
+    // The command's view and size for `--width 240`.
+    let view = View::fit(&doc, 0.0);
+    let height = (240.0 * view.height() / view.width()).round() as u32;
+    let (image, _) = render_image(&doc, &RenderOptions::new(240, height, view)).unwrap();
+    for (extra, bits, dither) in [
+        (&[][..], 8, true),
+        (&["--bits", "16"][..], 16, true),
+        (&["--no-dither"][..], 8, false),
+    ] {
+        let out = dir.path().join("out.png");
+        let mut args = vec!["render", s(&input), "-o", s(&out), "--width", "240"];
+        args.extend_from_slice(extra);
+        let o = gradmesh(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let expect = encode_png(&image, bits, dither).unwrap();
+        assert!(std::fs::read(&out).unwrap() == expect, "{extra:?}");
+    }
+}

@@ -92,17 +92,35 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
 
     let opts = options(args, &doc)?;
     let start = Instant::now();
-    let (mut image, info) = render::render_image(&doc, &opts)?;
+    let channels = 4 * opts.width as usize * opts.height as usize;
+    // Straight into the output's channel type, unless outlines are drawn on top (on the `f32`
+    // image): an `f32` image is four times the memory of 8-bit output.
+    let (pixels, info) = if args.boundary {
+        let (mut image, info) = render::render_image(&doc, &opts)?;
+        render::draw_outlines(&doc, &opts, &mut image)?;
+        (Pixels::Float(image), info)
+    } else if args.bits == 16 {
+        let mut data = vec![0u16; channels];
+        let info = render::render_document_into(&doc, &opts, &mut data)?;
+        (Pixels::Sixteen(data), info)
+    } else {
+        let mut data = vec![0u8; channels];
+        let info = render::render_document_into(&doc, &opts, &mut data)?;
+        (Pixels::Eight(data), info)
+    };
     let rendered = start.elapsed();
     for w in &info.warnings {
         eprintln!("gradmesh: warning: {w}");
     }
-    if args.boundary {
-        render::draw_outlines(&doc, &opts, &mut image)?;
-    }
 
     let start = Instant::now();
-    let png = render::encode_png(&image, args.bits, opts.dither)?;
+    let (w, h) = (opts.width, opts.height);
+    let png = match &pixels {
+        Pixels::Float(image) => render::encode_png(image, args.bits, opts.dither)?,
+        Pixels::Sixteen(data) => render::encode_png_rgba16(w, h, data)?,
+        Pixels::Eight(data) => render::encode_png_rgba8(w, h, data)?,
+    };
+    drop(pixels);
     formats::write_atomic(&args.output, &png)?;
     let written = start.elapsed();
 
@@ -132,4 +150,11 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         }
     }
     Ok(())
+}
+
+/// The rendered picture, in the type it was drawn in.
+enum Pixels {
+    Float(render::Image),
+    Sixteen(Vec<u16>),
+    Eight(Vec<u8>),
 }

@@ -135,31 +135,57 @@ impl Image {
 /// perceptual intent, with the fallback `gAMA` and `cHRM` the PNG specification recommends).
 /// `dither` applies to 8-bit output only.
 pub fn encode_png(image: &Image, bits: u8, dither: bool) -> Result<Vec<u8>, Error> {
-    let depth = match bits {
-        8 => png::BitDepth::Eight,
-        16 => png::BitDepth::Sixteen,
-        _ => {
-            return Err(ErrorKind::Invalid {
-                what: "PNG bit depth".into(),
-                message: format!("must be 8 or 16, not {bits}"),
-            }
-            .into())
+    match bits {
+        8 => encode_png_rgba8(image.width, image.height, &image.to_u8(dither)),
+        16 => encode_png_rgba16(image.width, image.height, &image.to_u16()),
+        _ => Err(ErrorKind::Invalid {
+            what: "PNG bit depth".into(),
+            message: format!("must be 8 or 16, not {bits}"),
         }
-    };
-    let bytes: Vec<u8> = if bits == 8 {
-        image.to_u8(dither)
-    } else {
-        use rayon::prelude::*;
-        image
-            .to_u16()
-            .par_iter()
-            .flat_map_iter(|v| v.to_be_bytes())
-            .collect()
-    };
+        .into()),
+    }
+}
+
+/// Encodes 8-bit RGBA (as [`super::render_document_into`] writes it: straight alpha,
+/// sRGB-encoded, rows top to bottom) as a PNG marked as sRGB. Rendering straight into bytes
+/// skips the `f32` image, four times the memory of the output.
+pub fn encode_png_rgba8(width: u32, height: u32, data: &[u8]) -> Result<Vec<u8>, Error> {
+    check_len(width, height, data.len())?;
+    write_png(width, height, png::BitDepth::Eight, data)
+}
+
+/// [`encode_png_rgba8`] for 16-bit channels.
+pub fn encode_png_rgba16(width: u32, height: u32, data: &[u16]) -> Result<Vec<u8>, Error> {
+    use rayon::prelude::*;
+    check_len(width, height, data.len())?;
+    let bytes: Vec<u8> = data.par_iter().flat_map_iter(|v| v.to_be_bytes()).collect();
+    write_png(width, height, png::BitDepth::Sixteen, &bytes)
+}
+
+fn check_len(width: u32, height: u32, len: usize) -> Result<(), Error> {
+    let need = 4 * width as u64 * height as u64;
+    if len as u64 != need {
+        return Err(ErrorKind::Invalid {
+            what: "pixels".into(),
+            message: format!(
+                "{len} channels for a {width}x{height} RGBA image, which needs {need}"
+            ),
+        }
+        .into());
+    }
+    Ok(())
+}
+
+fn write_png(
+    width: u32,
+    height: u32,
+    depth: png::BitDepth,
+    bytes: &[u8],
+) -> Result<Vec<u8>, Error> {
     let io = |e: png::EncodingError| Error::from(ErrorKind::Io(format!("PNG encoding: {e}")));
     let mut out = Vec::new();
     {
-        let mut enc = png::Encoder::new(&mut out, image.width, image.height);
+        let mut enc = png::Encoder::new(&mut out, width, height);
         enc.set_color(png::ColorType::Rgba);
         enc.set_depth(depth);
         enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
@@ -167,7 +193,7 @@ pub fn encode_png(image: &Image, bits: u8, dither: bool) -> Result<Vec<u8>, Erro
         // default level for a few percent more bytes; the pixels are the same.
         enc.set_compression(png::Compression::Fast);
         let mut writer = enc.write_header().map_err(io)?;
-        writer.write_image_data(&bytes).map_err(io)?;
+        writer.write_image_data(bytes).map_err(io)?;
         writer.finish().map_err(io)?;
     }
     Ok(out)
@@ -225,6 +251,13 @@ mod tests {
         let mean = q[2..].iter().map(|&v| v as f64).sum::<f64>() / (q.len() - 2) as f64;
         assert!((mean - 100.3).abs() < 0.05, "{mean}");
         assert!(img.to_u8(false)[2..].iter().all(|&v| v == 100));
+    }
+
+    #[test]
+    fn png_from_bytes_checks_the_length() {
+        assert!(encode_png_rgba8(3, 2, &[0; 24]).is_ok());
+        assert!(encode_png_rgba8(3, 2, &[0; 23]).is_err());
+        assert!(encode_png_rgba16(3, 2, &[0; 25]).is_err());
     }
 
     #[test]
