@@ -397,7 +397,7 @@ pub(super) fn tessellate(
             || t.face_edges(f).iter().any(|&e| {
                 t.edge_faces(e as usize)
                     .iter()
-                    .any(|&g| (g as usize) < nf && turns[g as usize] | turns[f] == 3)
+                    .any(|&g| (g as usize) < nf && (turns[g as usize] | turns[f]) == 3)
             })
     };
     plans

@@ -12,15 +12,17 @@
 //!    - **Fast path (feature-adaptive).** The mesh is refined to level 3 only (all quads,
 //!      extraordinary vertices isolated). Each face of that level gets its own grid density,
 //!      doubled until its cells pass the measure (colour held to three quarters of the
-//!      tolerance, since each face now stops right at it). A face whose neighbourhood is regular (valence-4 interior,
-//!      valence-3 boundary or corner vertices, no sharpness but the boundary's) is exactly a
-//!      uniform bicubic B-spline patch in position, colour and opacity, with phantom points
-//!      beyond a boundary, and is evaluated directly; any other face (extraordinary vertex,
-//!      crease, semi-sharp feature) is refined on its own, keeping at each depth only the faces
-//!      around its descendants. Faces of different densities are stitched without cracks: each
-//!      edge takes the finer count of its faces, both sides use bit-identical samples along it,
-//!      and the finer side collapses its extra boundary samples. Cells are drawn in the order
-//!      and with the diagonals of the quads uniform refinement would make (see `adaptive.rs`).
+//!      tolerance, since each face now stops right at it). A face whose neighbourhood is
+//!      regular (valence-4 interior, valence-3 boundary or corner vertices, no sharpness but
+//!      the boundary's) is exactly a uniform bicubic B-spline patch in position, colour and
+//!      opacity, with phantom points beyond a boundary, and is evaluated directly; any other
+//!      face (extraordinary vertex, crease, semi-sharp feature) is refined on its own, keeping
+//!      at each depth only the faces around its descendants. Faces of different densities are
+//!      stitched without cracks: a face rises to half its finest neighbour's count (the full
+//!      count where the surface folds), each edge takes the finer count of its faces, both
+//!      sides use bit-identical samples along it, and the coarser side fans its boundary cells
+//!      out to them. Cells are drawn in the order and with the diagonals of the quads uniform
+//!      refinement would make (see `adaptive.rs`).
 //!      Faces whose control points all lie off the image are not refined.
 //!    - **Uniform path** (reference mode, [`RenderOptions::level`], a
 //!      [`RenderOptions::max_level`] under 3, or a layer the fast path does not handle). The
