@@ -557,19 +557,14 @@ pub(super) fn tessellate(
                 }
             }
             match (apex, &centres[f]) {
-                (Some(_), _) => {
-                    for w in polygon[1..].windows(2) {
-                        push([polygon[0], w[0], w[1]]);
-                    }
-                }
                 (None, Some(centre)) => {
                     for i in 0..polygon.len() {
                         push([centre, polygon[i], polygon[(i + 1) % polygon.len()]]);
                     }
                 }
-                // Not reached (a one-cell face with a finer edge has a centre); a fan from
-                // a corner is the graceful fallback.
-                (None, None) => {
+                // From the apex corner; (None, None) is not reached (a one-cell face with a
+                // finer edge has a centre), and a fan from a corner is its graceful fallback.
+                _ => {
                     for w in polygon[1..].windows(2) {
                         push([polygon[0], w[0], w[1]]);
                     }
