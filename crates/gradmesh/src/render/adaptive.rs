@@ -10,9 +10,9 @@
 //!    is coarser (2:1 balance), or at the full count where the surface folds (a face whose
 //!    cells turn both ways, or which borders one turned the other way or folded: which sheet
 //!    shows depends on where the fold runs, and no measure checks that). Each edge then takes
-//!    the larger count of its two faces. Its samples are copied from a face of that count (the
-//!    first) to the other, and the samples at a vertex from the vertex's first face, so both
-//!    sides share bit-identical vertices. A face coarser than an edge fans the boundary cells
+//!    the larger count of its two faces. Both sides read its samples from a face of that count
+//!    (the first), and the samples at a vertex from the vertex's first face, so both sides
+//!    share bit-identical vertices. A face coarser than an edge fans the boundary cells
 //!    along it out to the edge's extra samples (from a cell corner off the edge, or from the
 //!    face's centre when it is a single cell), so no T-junction is left: the snapped,
 //!    top-left-rule rasteriser sees the same edges from both sides, without cracks. Before
@@ -35,7 +35,7 @@ use crate::validate::VertexData;
 
 use super::layer::{measure_quad, Measure, QuadSamples, Thresholds};
 use super::nearest::Segment;
-use super::patches::{regular_patch, ControlGrid, Grid, LocalPatch};
+use super::patches::{regular_corners, regular_patch_with, ControlGrid, Grid, LocalPatch};
 use super::triangles::{snap, Triangle, TriangleList};
 use super::view::ToPixels;
 
@@ -87,15 +87,19 @@ pub(super) struct Tessellation {
 }
 
 /// How a face's limit surface is evaluated.
+// A source lives on the stack of one face's planning: boxing the control grid would cost an
+// allocation per face.
+#[allow(clippy::large_enum_variant)]
 enum Source {
-    Regular(Box<ControlGrid>),
+    Regular(ControlGrid),
     Local(LocalPatch),
 }
 
 impl Source {
-    fn new(level: &Level, data: &[VertexData], f: usize) -> Option<Source> {
-        match regular_patch(level, data, f) {
-            Some(cp) => Some(Source::Regular(Box::new(cp))),
+    /// `regular`: whether each vertex of `level` is a regular corner ([`regular_corners`]).
+    fn new(level: &Level, regular: &[bool], data: &[VertexData], f: usize) -> Option<Source> {
+        match regular_patch_with(level, data, f, |v| regular[v]) {
+            Some(cp) => Some(Source::Regular(cp)),
             None => LocalPatch::new(level, data, f).map(Source::Local),
         }
     }
@@ -271,6 +275,9 @@ struct Plan {
     measured: Measure,
     capped: bool,
     estimated: bool,
+    /// The face's centre, kept when a one-cell plan was measured (the measure evaluates the
+    /// grid of two cells): a one-cell face fanned to finer edges needs it.
+    centre: Option<VertexData>,
 }
 
 /// Tessellates the layer adaptively, or `None` where the fast path does not apply (a face
@@ -317,16 +324,19 @@ pub(super) fn tessellate(
         [0, 1, 2, 3].map(|k| t.is_boundary_edge(t.face_edges(f)[k] as usize))
     };
 
+    let regular = regular_corners(level);
+
     // 1. The density of each face.
     let orders = CellOrders::new(n_max.max(1) * 2);
     let plan_face = |f: usize| -> Option<Plan> {
-        let mut src = Source::new(level, d, f)?;
+        let mut src = Source::new(level, &regular, d, f)?;
         let mut plan = Plan {
             n: 1,
             grid: src.grid(1)?,
             measured: Measure::default(),
             capped: false,
             estimated: false,
+            centre: None,
         };
         if src.off_image(xf, th.size) {
             return Some(plan);
@@ -349,6 +359,9 @@ pub(super) fn tessellate(
             );
             if passes(&m) {
                 plan.measured = m;
+                if plan.n == 1 {
+                    plan.centre = Some(finer[4]);
+                }
                 return Some(plan);
             }
             // Colour and size halve at least per level; the outline's distance quarters.
@@ -416,7 +429,7 @@ pub(super) fn tessellate(
                 plan.n.max(finest_edge / 2)
             };
             if n != plan.n {
-                plan.grid = Source::new(level, d, f)?.grid(n)?;
+                plan.grid = Source::new(level, &regular, d, f)?.grid(n)?;
                 plan.n = n;
             }
             Some(())
@@ -432,7 +445,12 @@ pub(super) fn tessellate(
                 .iter()
                 .any(|&e| edge_cells[e as usize] > plans[f].n);
             if plans[f].n == 1 && finer {
-                Source::new(level, d, f)?.grid(2).map(|g| Some(g[4]))
+                match plans[f].centre {
+                    Some(c) => Some(Some(c)),
+                    None => Source::new(level, &regular, d, f)?
+                        .grid(2)
+                        .map(|g| Some(g[4])),
+                }
             } else {
                 Some(None)
             }
@@ -440,35 +458,39 @@ pub(super) fn tessellate(
         .collect::<Option<_>>()?;
 
     // The shared samples: each edge's from its first face of the edge's count (which runs it
-    // from its first vertex to its second), each vertex's from its first face.
-    let edge_samples: Vec<Vec<VertexData>> = (0..t.edge_count())
+    // from its first vertex to its second), each vertex's from its first face. They are read
+    // from those faces' grids where needed rather than copied (fresh memory costs page faults).
+    let edge_sources: Vec<(u32, u8, bool)> = (0..t.edge_count())
+        .into_par_iter()
         .map(|e| {
             let ne = edge_cells[e];
             let owner = t
                 .edge_faces(e)
                 .into_iter()
                 .find(|&g| (g as usize) < nf && plans[g as usize].n >= ne)
-                .expect("an edge has a face of its count") as usize;
+                .expect("an edge has a face of its count");
             let k = t
-                .face_edges(owner)
+                .face_edges(owner as usize)
                 .iter()
                 .position(|&x| x as usize == e)
                 .expect("an edge is a side of its face");
-            let m = plans[owner].n;
-            let step = m / ne;
-            let mut samples: Vec<VertexData> = (0..=ne)
-                .map(|q| {
-                    let (i, j) = side_position(k, q * step, m);
-                    plans[owner].grid[j * (m + 1) + i]
-                })
-                .collect();
-            if t.face_vertices(owner)[k] != t.edge_vertices(e)[0] {
-                samples.reverse();
-            }
-            samples
+            let forward = t.face_vertices(owner as usize)[k] == t.edge_vertices(e)[0];
+            (owner, k as u8, forward)
         })
         .collect();
+    // Sample `s` (`0..=ne`) of edge `e`, from its first vertex.
+    let edge_sample = |e: usize, s: usize| -> &VertexData {
+        let (owner, k, forward) = edge_sources[e];
+        let plan = &plans[owner as usize];
+        let (m, ne) = (plan.n, edge_cells[e]);
+        let q = if forward { s } else { ne - s };
+        let (i, j) = side_position(k as usize, q * (m / ne), m);
+        &plan.grid[j * (m + 1) + i]
+    };
+    // Copied, unlike the edges': every face reads four, and one read here is one cache miss
+    // instead of a chain of them.
     let vertex_samples: Vec<VertexData> = (0..t.vertex_count())
+        .into_par_iter()
         .map(|v| {
             let (Some(&f), Some(&c)) =
                 (t.vertex_faces(v).first(), t.vertex_face_corners(v).first())
@@ -480,31 +502,44 @@ pub(super) fn tessellate(
             plans[f as usize].grid[j * (m + 1) + i]
         })
         .collect();
+    let vertex_sample = |v: usize| &vertex_samples[v];
     // The sample at position `s` (`0..=ne`) of edge `fe[k]`, counted from the face's corner `k`.
     let side_sample = |fv: &[u32], fe: &[u32], k: usize, s: usize| -> &VertexData {
         let e = fe[k] as usize;
         let ne = edge_cells[e];
         let forward = fv[k] == t.edge_vertices(e)[0];
-        &edge_samples[e][if forward { s } else { ne - s }]
+        edge_sample(e, if forward { s } else { ne - s })
     };
-    plans.par_iter_mut().enumerate().for_each(|(f, plan)| {
-        let m = plan.n;
-        let (fv, fe) = (t.face_vertices(f), t.face_edges(f));
-        for k in 0..4 {
-            let r = edge_cells[fe[k] as usize] / m;
-            for q in 0..=m {
-                let (i, j) = side_position(k, q, m);
-                plan.grid[j * (m + 1) + i] = *side_sample(fv, fe, k, q * r);
+    // Grid point `(i, j)` of face `f` as drawn: its corners are the vertices' samples, its
+    // sides the edges' (at the face's own count), the rest its own.
+    let face_sample = |f: usize, (i, j): (usize, usize)| -> &VertexData {
+        let m = plans[f].n;
+        let side = if j == 0 {
+            Some((0, i))
+        } else if i == m {
+            Some((1, j))
+        } else if j == m {
+            Some((2, m - i))
+        } else if i == 0 {
+            Some((3, m - j))
+        } else {
+            None
+        };
+        match side {
+            None => &plans[f].grid[j * (m + 1) + i],
+            Some((k, 0)) => vertex_sample(t.face_vertices(f)[k] as usize),
+            Some((k, q)) if q == m => vertex_sample(t.face_vertices(f)[(k + 1) % 4] as usize),
+            Some((k, q)) => {
+                let (fv, fe) = (t.face_vertices(f), t.face_edges(f));
+                let r = edge_cells[fe[k] as usize] / m;
+                side_sample(fv, fe, k, q * r)
             }
         }
-        for k in 0..4 {
-            let (i, j) = side_position(k, 0, m);
-            plan.grid[j * (m + 1) + i] = vertex_samples[fv[k] as usize];
-        }
-    });
+    };
 
     // 3. Triangles.
-    let face_triangles = |f: usize| -> Vec<Triangle> {
+    // Appends face `f`'s triangles to `out`.
+    let face_triangles = |out: &mut Vec<Triangle>, f: usize| {
         let plan = &plans[f];
         let m = plan.n;
         let (fv, fe) = (t.face_vertices(f), t.face_edges(f));
@@ -519,8 +554,7 @@ pub(super) fn tessellate(
                 _ => (i == 0).then_some(m - j),
             }
         };
-        let sample = |(i, j): (usize, usize)| &plan.grid[j * (m + 1) + i];
-        let mut out = Vec::with_capacity(2 * m * m);
+        let sample = |p: (usize, usize)| face_sample(f, p);
         let mut push = |d: [&VertexData; 3]| {
             if let Some(x) = screen_triangle(d, xf, size) {
                 out.push(x);
@@ -571,10 +605,19 @@ pub(super) fn tessellate(
                 }
             }
         }
-        out
     };
-    let triangles =
-        TriangleList::from_chunks((0..nf).into_par_iter().map(face_triangles).collect());
+    // Appended to one growing list per rayon job (collect keeps their order): a list per face,
+    // sized for all its cells' triangles, cost a fresh allocation per face, and most of a
+    // dense layer's triangles are culled.
+    let triangles = TriangleList::from_chunks(
+        (0..nf)
+            .into_par_iter()
+            .fold(Vec::new, |mut out, f| {
+                face_triangles(&mut out, f);
+                out
+            })
+            .collect(),
+    );
 
     // The boundary of the tessellation, loop by loop.
     let mut segments = Vec::new();
@@ -588,7 +631,8 @@ pub(super) fn tessellate(
             else {
                 continue;
             };
-            let mut s = edge_samples[e as usize].clone();
+            let ne = edge_cells[e as usize];
+            let mut s: Vec<VertexData> = (0..=ne).map(|q| *edge_sample(e as usize, q)).collect();
             if t.edge_vertices(e as usize)[0] != a {
                 s.reverse();
             }

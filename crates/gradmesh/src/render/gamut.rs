@@ -149,7 +149,8 @@ pub(crate) fn lab_to_linear_srgb(c: [f64; 3]) -> [f64; 3] {
         }
     };
     let (x, y, z) = (finv(fx), finv(fy), finv(fz));
-    [0, 1, 2].map(|i| m[i][0] * x + m[i][1] * y + m[i][2] * z)
+    let row = |r: &[f64; 3]| r[0] * x + r[1] * y + r[2] * z;
+    [row(&m[0]), row(&m[1]), row(&m[2])]
 }
 
 /// Octaves of the encoding table: linear values from `2^-ENCODE_OCTAVES` to 1.

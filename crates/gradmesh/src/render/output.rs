@@ -57,7 +57,14 @@ pub(crate) fn dither_noise(x: u32, y: u32) -> [f32; 4] {
     v = (v ^ (v >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     v ^= v >> 31;
     let b = v.to_le_bytes();
-    [0, 1, 2, 3].map(|c| (b[2 * c] as f32 + b[2 * c + 1] as f32 + 1.0) / 256.0 - 1.0)
+    // Written out: `[_; 4].map` with a closure was left as a call per pixel.
+    let tpdf = |lo: u8, hi: u8| (lo as f32 + hi as f32 + 1.0) / 256.0 - 1.0;
+    [
+        tpdf(b[0], b[1]),
+        tpdf(b[2], b[3]),
+        tpdf(b[4], b[5]),
+        tpdf(b[6], b[7]),
+    ]
 }
 
 /// An RGBA image with `f32` channels: straight (non-premultiplied) alpha, sRGB-encoded colour

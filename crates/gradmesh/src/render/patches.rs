@@ -20,6 +20,7 @@ use crate::mesh::BoundaryInterpolation;
 use crate::rules::{self, VertexRule};
 use crate::topology::Topology;
 use crate::validate::VertexData;
+use rayon::prelude::*;
 
 /// Samples `(n + 1)^2` of the limit surface over one face, row by row: index `j * (n + 1) + i`
 /// is at parameter `(i / n, j / n)`, `u` running from the face's corner 0 to corner 1 and `v`
@@ -124,7 +125,27 @@ fn regular_corner(level: &Level, v: usize) -> bool {
 
 /// The control points of face `f` of `level` (with data `data`) if its limit surface is a
 /// regular B-spline patch (see the module documentation), phantom points included.
+#[cfg(test)]
 pub(crate) fn regular_patch(level: &Level, data: &[VertexData], f: usize) -> Option<ControlGrid> {
+    regular_patch_with(level, data, f, |v| regular_corner(level, v))
+}
+
+/// Whether each vertex of `level` is a [`regular_patch`] corner: computed once for a level,
+/// rather than four times (once per face around it) by [`regular_patch`].
+pub(crate) fn regular_corners(level: &Level) -> Vec<bool> {
+    (0..level.topology.vertex_count())
+        .into_par_iter()
+        .map(|v| regular_corner(level, v))
+        .collect()
+}
+
+/// [`regular_patch`] with the corners' regularity given (see [`regular_corners`]).
+pub(crate) fn regular_patch_with(
+    level: &Level,
+    data: &[VertexData],
+    f: usize,
+    regular: impl Fn(usize) -> bool,
+) -> Option<ControlGrid> {
     let t = &level.topology;
     let fv = t.face_vertices(f);
     if fv.len() != 4 {
@@ -146,7 +167,7 @@ pub(crate) fn regular_patch(level: &Level, data: &[VertexData], f: usize) -> Opt
     let sub = |a: (isize, isize), b: (isize, isize)| (a.0 - b.0, a.1 - b.1);
     for c in 0..4 {
         let v = fv[c] as usize;
-        if !regular_corner(level, v) {
+        if !regular(v) {
             return None;
         }
         let (g, g_next, g_prev) = (

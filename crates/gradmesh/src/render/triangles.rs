@@ -18,8 +18,17 @@ const SMALL_ROWS: i64 = 1 << 16;
 
 /// Snaps a pixel coordinate to the sub-pixel grid; `None` if it is not finite or too large.
 pub(crate) fn snap(v: f64) -> Option<i64> {
-    let s = (v * SUBPIXEL as f64).round();
-    (s.is_finite() && s.abs() < LIMIT as f64).then_some(s as i64)
+    let s = v * SUBPIXEL as f64;
+    // `f64::round` without its library call (baseline x86-64 has no rounding instruction):
+    // below 2^40 the fraction `s - trunc(s)` is exact, so this rounds half away from zero
+    // exactly as `round` does.
+    if s.is_nan() || s.abs() >= LIMIT as f64 {
+        return None;
+    }
+    let t = s as i64;
+    let frac = s - t as f64;
+    let rounded = t + (frac >= 0.5) as i64 - (frac <= -0.5) as i64;
+    (rounded.abs() < LIMIT).then_some(rounded)
 }
 
 /// One edge of a triangle: start point and direction in sub-pixel units, and whether pixel
@@ -358,6 +367,40 @@ impl Triangle {
 
 #[cfg(test)]
 mod tests {
+    /// `snap` rounds exactly as `f64::round` does, halves and limits included.
+    #[test]
+    fn snap_matches_round() {
+        let by_round = |v: f64| {
+            let s = (v * SUBPIXEL as f64).round();
+            (s.is_finite() && s.abs() < LIMIT as f64).then_some(s as i64)
+        };
+        let limit_px = LIMIT as f64 / SUBPIXEL as f64;
+        let mut values = vec![
+            0.0,
+            -0.0,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            limit_px,
+            -limit_px,
+            limit_px - 0.5 / SUBPIXEL as f64,
+            limit_px - 1e-9,
+            1e300,
+        ];
+        for k in 1..2000 {
+            // Exact halves and quarters of a sub-pixel step, and values next to them.
+            let v = k as f64 / (4.0 * SUBPIXEL as f64);
+            let (up, down) = (
+                f64::from_bits(v.to_bits() + 1),
+                f64::from_bits(v.to_bits() - 1),
+            );
+            values.extend([v, up, down, -v, -up, -down, v * 1e6 + 0.123]);
+        }
+        for v in values {
+            assert_eq!(snap(v), by_round(v), "{v:e}");
+        }
+    }
+
     use super::*;
 
     fn p(x: f64, y: f64) -> [i64; 2] {
