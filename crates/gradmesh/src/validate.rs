@@ -79,6 +79,10 @@ fn invalid(what: String, message: impl Into<String>) -> Error {
     .into()
 }
 
+/// Points whose colour lies outside the sRGB gamut that get a warning each; the rest are
+/// counted in one more.
+const GAMUT_WARNINGS_LISTED: usize = 10;
+
 /// Checks a mesh; on success returns the warnings (legal but suspicious input).
 pub fn validate(mesh: &GradientMesh) -> Result<Vec<Warning>, Error> {
     BaseMesh::new(mesh).map(|(_, warnings)| warnings)
@@ -359,17 +363,32 @@ impl BaseMesh {
         for v in unused {
             warn(&mut warnings, format!("point {v} is not used by any face"));
         }
+        // One warning per point for the first few; a count for the rest (a mesh made in a wide
+        // space may have thousands, and formatting them cost a tenth of validation).
+        let mut outside = 0usize;
         for (v, p) in mesh.points.iter().enumerate() {
             if !mesh.colour_space.in_srgb_gamut(p.colour) {
-                warn(
-                    &mut warnings,
-                    format!(
-                        "point {v}: colour {:?} ({}) is outside the sRGB gamut",
-                        p.colour,
-                        mesh.colour_space.name()
-                    ),
-                );
+                outside += 1;
+                if outside <= GAMUT_WARNINGS_LISTED {
+                    warn(
+                        &mut warnings,
+                        format!(
+                            "point {v}: colour {:?} ({}) is outside the sRGB gamut",
+                            p.colour,
+                            mesh.colour_space.name()
+                        ),
+                    );
+                }
             }
+        }
+        if outside > GAMUT_WARNINGS_LISTED {
+            warn(
+                &mut warnings,
+                format!(
+                    "{} more points have colours outside the sRGB gamut",
+                    outside - GAMUT_WARNINGS_LISTED
+                ),
+            );
         }
 
         Ok((

@@ -200,3 +200,36 @@ fn warnings_for_suspicious_input() {
     );
     assert_eq!(warnings.len(), 3, "{warnings:?}");
 }
+
+/// Thousands of colours outside the gamut give ten warnings naming points and one counting the
+/// rest, not a warning each.
+#[test]
+fn many_colours_outside_the_gamut_are_counted() {
+    let mut m = GradientMesh::new(ColourSpace::Lab);
+    let n = 40u32;
+    for j in 0..=n {
+        for i in 0..=n {
+            // Every other point far outside the sRGB gamut.
+            let a = if (i + j) % 2 == 0 { 150.0 } else { 0.0 };
+            m.add_point(Point::new(i as f64, j as f64), [50.0, a, 0.0]);
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            let v = j * (n + 1) + i;
+            m.add_face(vec![v, v + 1, v + n + 2, v + n + 1]);
+        }
+    }
+    let warnings: Vec<String> = validate(&m)
+        .unwrap()
+        .iter()
+        .map(|w| w.to_string())
+        .collect();
+    assert_eq!(warnings.len(), 11, "{warnings:?}");
+    assert!(warnings[0].starts_with("point 0: colour [50.0, 150.0, 0.0]"));
+    assert!(warnings[9].starts_with("point 18: colour"), "{warnings:?}");
+    assert_eq!(
+        warnings[10],
+        "831 more points have colours outside the sRGB gamut"
+    );
+}
