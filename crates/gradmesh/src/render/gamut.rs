@@ -145,9 +145,10 @@ pub(crate) fn to_blend_space_f32(
 fn lab_to_linear_srgb_f32(c: [f32; 3]) -> [f32; 3] {
     static MATRIX: std::sync::OnceLock<[[f32; 3]; 3]> = std::sync::OnceLock::new();
     let m = MATRIX.get_or_init(|| lab_matrix().map(|row| row.map(|v| v as f32)));
-    let fy = (c[0] + 16.0) / 116.0;
-    let fx = fy + c[1] / 500.0;
-    let fz = fy - c[2] / 200.0;
+    // Products by reciprocals: a rounding apart from the quotients, a division's time less.
+    let fy = (c[0] + 16.0) * (1.0 / 116.0);
+    let fx = fy + c[1] * (1.0 / 500.0);
+    let fz = fy - c[2] * (1.0 / 200.0);
     let finv = |t: f32| {
         if t > 6.0 / 29.0 {
             t * t * t

@@ -615,7 +615,8 @@ fn draw_band<P: OutputPixel>(
 }
 
 /// A premultiplied colour of the blend space as straight-alpha, sRGB-encoded channels.
-#[inline]
+// Always inlined: called once per pixel from two loops, it was left as a call.
+#[inline(always)]
 fn straight_srgb(c: &[f32; 4], linear: bool) -> [f32; 4] {
     let a = c[3];
     if a.is_nan() || a <= 0.0 {

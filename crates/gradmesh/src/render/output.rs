@@ -18,6 +18,7 @@ pub trait OutputPixel: Copy + Send + Sync + 'static {
 
 impl OutputPixel for f32 {
     const DITHERED: bool = false;
+    #[inline(always)]
     fn encode(v: f32, _noise: f32) -> Self {
         v
     }
@@ -25,6 +26,7 @@ impl OutputPixel for f32 {
 
 impl OutputPixel for u16 {
     const DITHERED: bool = false;
+    #[inline(always)]
     fn encode(v: f32, _noise: f32) -> Self {
         (v.clamp(0.0, 1.0) * 65535.0 + 0.5) as u16
     }
@@ -32,6 +34,7 @@ impl OutputPixel for u16 {
 
 impl OutputPixel for u8 {
     const DITHERED: bool = true;
+    #[inline(always)]
     fn encode(v: f32, noise: f32) -> Self {
         if v <= 0.0 {
             0
@@ -50,6 +53,7 @@ impl OutputPixel for u8 {
 /// quantisation error is independent of the signal and smooth gradients show no bands. No
 /// pattern repeats at a small period, unlike a Bayer matrix. One hash serves the whole pixel
 /// (eight bytes of noise at 1/256 of an output step are plenty).
+#[inline(always)]
 pub(crate) fn dither_noise(x: u32, y: u32) -> [f32; 4] {
     // splitmix64's finaliser of the position.
     let mut v = ((y as u64) << 32 | x as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
