@@ -1,8 +1,10 @@
 //! Whole renders of the gallery examples (`examples/*.json`) at 1024 pixels on the longer
-//! side, and the floor: filling the same RGBA `f32` buffer with one colour.
+//! side, and the floor: filling the same RGBA `f32` buffer with one colour. Then the authors'
+//! six-layer Tucan at 1024 pixels wide into an 8-bit buffer, from scratch and as an editor
+//! re-renders it after one layer changed (`RenderCache`).
 //!
 //! Run: `cargo bench -p gradmesh --bench render` (add a name to run one example, e.g.
-//! `-- rectangle`).
+//! `-- rectangle`, or `-- tucan` for the editing figures).
 
 #![allow(missing_docs)] // criterion_group! generates undocumented items.
 
@@ -11,7 +13,10 @@ use std::time::Duration;
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use gradmesh::formats;
-use gradmesh::render::{render_document, RenderOptions};
+use gradmesh::render::{
+    render_document, render_document_into, render_document_into_cached, RenderCache, RenderOptions,
+};
+use gradmesh::Document;
 
 const SIZE: u32 = 1024;
 
@@ -51,5 +56,49 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+/// The six Tucan layers, bottom to top, from the shared real data beside the repository.
+fn tucan() -> Option<Document> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/realdata/gradientmeshimproved-off");
+    let mut layers = Vec::new();
+    for i in (0..6).rev() {
+        let path = dir.join(format!("Tucan_Tucan_Layer{i}.off"));
+        let mut doc = formats::read_path(&path).ok()?;
+        layers.push(doc.layers.remove(0));
+    }
+    Some(Document { layers })
+}
+
+fn bench_editing(c: &mut Criterion) {
+    let Some(doc) = tucan() else {
+        eprintln!("shared/realdata not found: skipping the Tucan benchmarks");
+        return;
+    };
+    let opts = RenderOptions::fit(&doc, SIZE);
+    let mut buffer = vec![0u8; 4 * (opts.width * opts.height) as usize];
+    let mut g = c.benchmark_group("tucan_1024");
+    g.sample_size(20).measurement_time(Duration::from_secs(5));
+    g.bench_function("from_scratch", |b| {
+        b.iter(|| render_document_into(black_box(&doc), &opts, &mut buffer).unwrap())
+    });
+    // An edit moves a point of one layer back and forth, so every iteration prepares that
+    // layer again and takes the others from the cache.
+    for (name, layer) in [("edit_top_layer", 5), ("edit_densest_layer", 3)] {
+        let mut doc = doc.clone();
+        let mut cache = RenderCache::new();
+        render_document_into_cached(&doc, &opts, &mut cache, &mut buffer).unwrap();
+        let mut moved = false;
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                moved = !moved;
+                doc.layers[layer].points[0].position.x += if moved { 0.5 } else { -0.5 };
+                render_document_into_cached(black_box(&doc), &opts, &mut cache, &mut buffer)
+                    .unwrap()
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, bench_editing);
 criterion_main!(benches);

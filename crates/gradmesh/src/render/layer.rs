@@ -647,6 +647,7 @@ pub(crate) fn prepare(
                 max_colour_error: tess.measured.colour,
                 estimated: tess.estimated,
                 timings,
+                reused: false,
             };
             (tess.base_level, tess.triangles, tess.segments, info)
         }
@@ -665,6 +666,7 @@ pub(crate) fn prepare(
                 max_colour_error: choice.measured.map_or(f64::NAN, |m| m.colour),
                 estimated: choice.estimated,
                 timings,
+                reused: false,
             };
             (choice.level, triangles, segments, info)
         }

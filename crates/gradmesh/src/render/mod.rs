@@ -59,6 +59,10 @@
 //! Rows are split into bands of 16 drawn in parallel with rayon; every band does the same
 //! arithmetic whichever thread runs it, so the output does not depend on the thread count.
 //!
+//! Steps 1 and 2 make each layer's *prepared* form (triangles, outline, nearest-boundary table,
+//! binned into bands); steps 3 and 4 draw. A [`RenderCache`] keeps prepared layers between
+//! renders, so an editor pays only for the layers an edit changed.
+//!
 //! ```
 //! use gradmesh::render::{render_document, RenderOptions, View};
 //! use gradmesh::{ColourSpace, Document, GradientMesh};
@@ -297,8 +301,10 @@ pub struct LayerInfo {
     /// Whether the three figures above are estimated from the level above (halving per level,
     /// the outline's distance quartering) rather than measured at the level drawn.
     pub estimated: bool,
-    /// Time spent on each stage of preparing this layer.
+    /// Time spent on each stage of preparing this layer (zero when [`LayerInfo::reused`]).
     pub timings: LayerTimings,
+    /// Whether the layer was taken from a [`RenderCache`] rather than prepared.
+    pub reused: bool,
 }
 
 /// Wall-clock time of the stages that prepare one layer (layers are prepared in parallel, so
@@ -362,6 +368,63 @@ pub fn render_document_into<P: OutputPixel>(
     opts: &RenderOptions,
     out: &mut [P],
 ) -> Result<RenderInfo, Error> {
+    render(doc, opts, None, out)
+}
+
+/// Layers prepared for drawing (refined, tessellated and binned), kept between renders of a
+/// document being edited: [`render_document_into_cached`] prepares again only the layers whose
+/// mesh changed, or all of them when an option that shapes the preparation (size, view,
+/// tolerances, levels, colour space) did. Background, dither, gamut mapping and blend space
+/// only affect drawing.
+///
+/// An editor that drags a point of one layer then pays for that layer's preparation and the
+/// drawing, not for the other layers. The cache holds a copy of each mesh it compares against,
+/// and the prepared triangles and outlines (a few megabytes for a dense layer at 1024 pixels).
+#[derive(Default)]
+pub struct RenderCache {
+    /// The options the entries were prepared with, with the drawing-only fields reset.
+    key: Option<RenderOptions>,
+    /// Per layer, by position: the mesh prepared and what preparing it gave.
+    layers: Vec<Option<(GradientMesh, layer::Prepared)>>,
+}
+
+impl RenderCache {
+    /// An empty cache.
+    pub fn new() -> Self {
+        RenderCache::default()
+    }
+
+    /// The fields of `opts` that preparing a layer reads.
+    fn key(opts: &RenderOptions) -> RenderOptions {
+        RenderOptions {
+            background: None,
+            dither: false,
+            gamut: GamutMapping::default(),
+            blend: BlendSpace::default(),
+            max_pixels: 0,
+            ..opts.clone()
+        }
+    }
+}
+
+/// [`render_document_into`], reusing the layers of `cache` that are unchanged (see
+/// [`RenderCache`]); the result is identical. [`LayerInfo::reused`] tells which layers were
+/// taken from the cache.
+pub fn render_document_into_cached<P: OutputPixel>(
+    doc: &Document,
+    opts: &RenderOptions,
+    cache: &mut RenderCache,
+    out: &mut [P],
+) -> Result<RenderInfo, Error> {
+    render(doc, opts, Some(cache), out)
+}
+
+fn render<P: OutputPixel>(
+    doc: &Document,
+    opts: &RenderOptions,
+    mut cache: Option<&mut RenderCache>,
+    out: &mut [P],
+) -> Result<RenderInfo, Error> {
     opts.check()?;
     let (w, h) = (opts.width as usize, opts.height as usize);
     if out.len() != 4 * w * h {
@@ -377,18 +440,66 @@ pub fn render_document_into<P: OutputPixel>(
     }
     let xf = ToPixels::new(&opts.view, opts.width, opts.height);
     let start = Instant::now();
-    let prepared: Vec<layer::Prepared> = doc
+    if let Some(cache) = cache.as_deref_mut() {
+        let key = RenderCache::key(opts);
+        if cache.key.as_ref() != Some(&key) {
+            cache.key = Some(key);
+            cache.layers.clear();
+        }
+        cache.layers.resize_with(doc.layers.len(), || None);
+    }
+    // The layers to prepare (`None`: taken from the cache).
+    let cached = cache.as_deref().map(|c| c.layers.as_slice());
+    let fresh: Vec<Option<layer::Prepared>> = doc
         .layers
         .par_iter()
         .enumerate()
-        .map(|(i, mesh)| layer::prepare(mesh, i, opts, &xf))
+        .map(|(i, mesh)| {
+            let hit = cached
+                .and_then(|c| c[i].as_ref())
+                .is_some_and(|(old, _)| old == mesh);
+            if hit {
+                Ok(None)
+            } else {
+                layer::prepare(mesh, i, opts, &xf).map(Some)
+            }
+        })
         .collect::<Result<_, _>>()?;
+    let reused: Vec<bool> = fresh.iter().map(Option::is_none).collect();
+    let kept: Vec<layer::Prepared>;
+    let prepared: Vec<&layer::Prepared> = match cache {
+        Some(cache) => {
+            for (i, fresh) in fresh.into_iter().enumerate() {
+                if let Some(p) = fresh {
+                    cache.layers[i] = Some((doc.layers[i].clone(), p));
+                }
+            }
+            // Every entry was just filled or matched.
+            cache
+                .layers
+                .iter()
+                .map(|entry| &entry.as_ref().expect("filled or matched above").1)
+                .collect()
+        }
+        None => {
+            kept = fresh
+                .into_iter()
+                .map(|p| p.expect("prepared: there is no cache"))
+                .collect();
+            kept.iter().collect()
+        }
+    };
     let mut info = RenderInfo::default();
-    let mut layers = Vec::new();
-    for (layer_info, layer, warnings) in prepared {
+    let mut layers: Vec<&PreparedLayer> = Vec::new();
+    for ((layer_info, layer, warnings), reused) in prepared.into_iter().zip(reused) {
+        let mut layer_info = layer_info.clone();
+        if reused {
+            layer_info.reused = true;
+            layer_info.timings = LayerTimings::default();
+        }
         info.layers.push(layer_info);
-        info.warnings.extend(warnings);
-        layers.extend(layer);
+        info.warnings.extend(warnings.iter().cloned());
+        layers.extend(layer.as_ref());
     }
     info.timings.prepare = start.elapsed();
 
@@ -473,7 +584,7 @@ impl Scratch {
 fn draw_band<P: OutputPixel>(
     band: usize,
     out: &mut [P],
-    layers: &[PreparedLayer],
+    layers: &[&PreparedLayer],
     opts: &RenderOptions,
     background: Option<[f32; 4]>,
     s: &mut Scratch,

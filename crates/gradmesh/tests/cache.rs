@@ -1,0 +1,90 @@
+//! `RenderCache`: renders that reuse prepared layers are identical to renders from scratch, and
+//! only the layers that changed (or all, when an option that shapes preparation changed) are
+//! prepared again.
+
+use gradmesh::formats::read_path;
+use gradmesh::render::{
+    document_bounds, render_document_into, render_document_into_cached, RenderCache, RenderOptions,
+    View,
+};
+use gradmesh::Document;
+
+/// The six layers of the authors' Tucan, bottom to top.
+fn tucan() -> Document {
+    let dir = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/realdata/gradientmeshimproved-off/"
+    );
+    let layers = (0..6)
+        .rev()
+        .map(|i| {
+            let path = format!("{dir}Tucan_Tucan_Layer{i}.off");
+            let mut doc = read_path(std::path::Path::new(&path)).unwrap();
+            doc.layers.remove(0)
+        })
+        .collect();
+    Document { layers }
+}
+
+fn options(doc: &Document, width: u32) -> RenderOptions {
+    let b = document_bounds(doc).unwrap();
+    let height = (width as f64 * b.height() / b.width()).ceil() as u32;
+    RenderOptions::new(width, height, View::new(b.x0, b.y0, b.x1, b.y1))
+}
+
+/// Renders with the cache and from scratch; asserts the pixels agree and returns which layers
+/// were reused.
+fn render_both(doc: &Document, opts: &RenderOptions, cache: &mut RenderCache) -> Vec<bool> {
+    let n = 4 * (opts.width * opts.height) as usize;
+    let (mut cached, mut fresh) = (vec![0u8; n], vec![0u8; n]);
+    let info = render_document_into_cached(doc, opts, cache, &mut cached).unwrap();
+    let plain = render_document_into(doc, opts, &mut fresh).unwrap();
+    assert!(cached == fresh, "cached and fresh renders differ");
+    assert!(plain.layers.iter().all(|l| !l.reused));
+    for (a, b) in info.layers.iter().zip(&plain.layers) {
+        // Everything but the timings is what preparing again gives.
+        assert_eq!(
+            (a.level, a.quads, a.triangles),
+            (b.level, b.quads, b.triangles)
+        );
+    }
+    assert_eq!(info.warnings, plain.warnings);
+    info.layers.iter().map(|l| l.reused).collect()
+}
+
+#[test]
+fn cached_renders_equal_fresh_ones_and_prepare_only_what_changed() {
+    let mut doc = tucan();
+    let mut opts = options(&doc, 300);
+    let mut cache = RenderCache::new();
+
+    assert_eq!(render_both(&doc, &opts, &mut cache), [false; 6]);
+    assert_eq!(render_both(&doc, &opts, &mut cache), [true; 6]);
+
+    // An edit of one layer: only that one is prepared again.
+    let p = &mut doc.layers[3].points[5];
+    p.colour = [p.colour[0] * 0.8, p.colour[1] + 10.0, p.colour[2]];
+    assert_eq!(
+        render_both(&doc, &opts, &mut cache),
+        [true, true, true, false, true, true]
+    );
+
+    // Drawing-only options keep every layer.
+    opts.background = Some([1.0, 1.0, 1.0, 1.0]);
+    opts.dither = false;
+    assert_eq!(render_both(&doc, &opts, &mut cache), [true; 6]);
+
+    // A new size prepares everything again.
+    opts.width = 320;
+    opts.height += 10;
+    assert_eq!(render_both(&doc, &opts, &mut cache), [false; 6]);
+
+    // A layer removed from the top, then one added: positions that still match are kept.
+    let top = doc.layers.pop().unwrap();
+    assert_eq!(render_both(&doc, &opts, &mut cache), [true; 5]);
+    doc.layers.push(top);
+    assert_eq!(
+        render_both(&doc, &opts, &mut cache),
+        [true, true, true, true, true, false]
+    );
+}
