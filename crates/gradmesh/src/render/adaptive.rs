@@ -330,15 +330,28 @@ pub(super) fn tessellate(
     let orders = CellOrders::new(n_max.max(1) * 2);
     let plan_face = |f: usize| -> Option<Plan> {
         let mut src = Source::new(level, &regular, d, f)?;
+        let off_image = src.off_image(xf, th.size);
+        // A regular patch's grid of two cells holds its grid of one (the same parameters and
+        // arithmetic): evaluate it once and take its corners. (Local refinement evaluates each
+        // depth on its own, so it keeps its order of evaluation.)
+        let mut next = None;
+        let grid = if matches!(src, Source::Regular(_)) && !off_image && n_max > 1 {
+            let g2 = src.grid(2)?;
+            let g1 = [0, 2, 6, 8].map(|k| g2[k]).to_vec();
+            next = Some(g2);
+            g1
+        } else {
+            src.grid(1)?
+        };
         let mut plan = Plan {
             n: 1,
-            grid: src.grid(1)?,
+            grid,
             measured: Measure::default(),
             capped: false,
             estimated: false,
             centre: None,
         };
-        if src.off_image(xf, th.size) {
+        if off_image {
             return Some(plan);
         }
         let boundary = boundary_sides(f);
@@ -347,7 +360,10 @@ pub(super) fn tessellate(
                 plan.capped = true;
                 return Some(plan);
             }
-            let finer = src.grid(2 * plan.n)?;
+            let finer = match next.take() {
+                Some(g) => g,
+                None => src.grid(2 * plan.n)?,
+            };
             let m = measure_grid(
                 &plan.grid,
                 plan.n,

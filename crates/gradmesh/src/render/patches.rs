@@ -64,11 +64,19 @@ pub(crate) fn evaluate_patch_at(cp: &ControlGrid, u: f64, v: f64) -> VertexData 
 
 /// The patch of `cp` on a grid of `n x n` cells.
 pub(crate) fn evaluate_patch(cp: &ControlGrid, n: usize) -> Grid {
-    let basis: Vec<[f64; 4]> = (0..=n)
-        .map(|i| bspline_basis(i as f64 / n as f64))
-        .collect();
+    // Most faces stop at a few cells: their basis values stay on the stack.
+    let (mut small, mut large) = ([[0.0; 4]; 17], Vec::new());
+    let basis: &mut [[f64; 4]] = if n < small.len() {
+        &mut small[..=n]
+    } else {
+        large.resize(n + 1, [0.0; 4]);
+        &mut large
+    };
+    for (i, b) in basis.iter_mut().enumerate() {
+        *b = bspline_basis(i as f64 / n as f64);
+    }
     let mut out = Vec::with_capacity((n + 1) * (n + 1));
-    for bv in &basis {
+    for bv in basis.iter() {
         // The four columns collapsed to this row's curve first: 16 then 4 terms per sample.
         let mut q = [[0.0; 6]; 4];
         for (i, qi) in q.iter_mut().enumerate() {
@@ -78,7 +86,7 @@ pub(crate) fn evaluate_patch(cp: &ControlGrid, n: usize) -> Grid {
                 }
             }
         }
-        for bu in &basis {
+        for bu in basis.iter() {
             let mut p = [0.0; 6];
             for (i, qi) in q.iter().enumerate() {
                 for k in 0..6 {
