@@ -54,8 +54,9 @@ const MIN_BASE_FACE_PIXELS: usize = 16;
 /// level 2's would.
 fn base_level(refinement: &Refinement, size: (i64, i64)) -> usize {
     let pixels = (size.0.max(0) as usize).saturating_mul(size.1.max(0) as usize);
-    // Level 2 is all quads, so level 3 has four times its faces.
-    let faces2 = refinement.topology(2).face_count();
+    // Each n-gon of level 1 makes n quads of level 2 (which need not be built to count them),
+    // and level 3 has four times as many.
+    let faces2 = refinement.topology(1).corner_count();
     let too_many = |faces: usize| faces.saturating_mul(MIN_BASE_FACE_PIXELS) > pixels;
     if too_many(faces2) && refinement.topology(1).is_all_quads() {
         1

@@ -452,6 +452,7 @@ fn choose_level(
     // Edits of level k show fully from level k + 1 (their rings are set there).
     let wanted = refinement.base().edits.deepest_level() + 1;
     let mut k = 2;
+    extend(refinement, data, k);
     while k < wanted
         && refinement.topology(k).corner_count() <= opts.max_quads
         && k < opts.max_level.max(2)
@@ -611,7 +612,9 @@ pub(crate) fn prepare(
     let space = opts.colour_space_override.unwrap_or(mesh.colour_space);
     let original_space = mesh.colour_space;
     let mesh = in_space(mesh, space);
-    let (mut refinement, warnings) = Refinement::new(&mesh, 2).map_err(|e| e.in_layer(index))?;
+    // Level 1 only: the fast path of a dense layer starts there, and each path builds the
+    // levels it needs (level 2 of a 10,000-face mesh alone took about 100 ms).
+    let (mut refinement, warnings) = Refinement::new(&mesh, 1).map_err(|e| e.in_layer(index))?;
     // The edits' colours stay in the space they were written in.
     refinement.set_edit_colour_space(original_space);
     let warnings = warnings
