@@ -215,19 +215,20 @@ const ENCODE_OCTAVES: u32 = 9;
 /// Table entries per octave (a power of two).
 const ENCODE_STEPS: u32 = 1 << 10;
 
-/// [`srgb_encode`] at the start of every step of the table's octaves, and 1 at the end.
+/// [`srgb_encode`] at the start of every one of `steps` steps per octave of the table's
+/// octaves, and 1 at the end.
+fn encode_samples(steps: u32) -> impl Iterator<Item = f64> {
+    (0..=ENCODE_OCTAVES * steps).map(move |i| {
+        let octave = (i / steps) as i32 - ENCODE_OCTAVES as i32;
+        let m = 1.0 + (i % steps) as f64 / steps as f64;
+        srgb_encode(m * 2f64.powi(octave))
+    })
+}
+
+/// The table of [`srgb_encode_fast`].
 fn encode_table() -> &'static [f64] {
     static TABLE: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
-    TABLE.get_or_init(|| {
-        let n = ENCODE_OCTAVES * ENCODE_STEPS;
-        (0..=n)
-            .map(|i| {
-                let octave = (i / ENCODE_STEPS) as i32 - ENCODE_OCTAVES as i32;
-                let m = 1.0 + (i % ENCODE_STEPS) as f64 / ENCODE_STEPS as f64;
-                srgb_encode(m * 2f64.powi(octave))
-            })
-            .collect()
-    })
+    TABLE.get_or_init(|| encode_samples(ENCODE_STEPS).collect())
 }
 
 /// [`srgb_encode`] by a table with linear interpolation within each of 1024 steps per octave
@@ -254,19 +255,10 @@ pub(crate) fn srgb_encode_fast(linear: f64) -> f64 {
 /// table in the first-level cache.
 const ENCODE_STEPS_F32: u32 = 1 << 8;
 
-/// [`srgb_encode`] at the start of every step of [`srgb_encode_f32`]'s octaves, and 1 at the end.
+/// The table of [`srgb_encode_f32`].
 fn encode_table_f32() -> &'static [f32] {
     static TABLE: std::sync::OnceLock<Vec<f32>> = std::sync::OnceLock::new();
-    TABLE.get_or_init(|| {
-        let n = ENCODE_OCTAVES * ENCODE_STEPS_F32;
-        (0..=n)
-            .map(|i| {
-                let octave = (i / ENCODE_STEPS_F32) as i32 - ENCODE_OCTAVES as i32;
-                let m = 1.0 + (i % ENCODE_STEPS_F32) as f64 / ENCODE_STEPS_F32 as f64;
-                srgb_encode(m * 2f64.powi(octave)) as f32
-            })
-            .collect()
-    })
+    TABLE.get_or_init(|| encode_samples(ENCODE_STEPS_F32).map(|v| v as f32).collect())
 }
 
 /// [`srgb_encode`] in single precision: a table with linear interpolation within each of 256
