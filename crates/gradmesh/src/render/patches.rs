@@ -283,36 +283,38 @@ pub(crate) struct LocalPatch {
     levels: Vec<LocalLevel>,
 }
 
-/// The faces `keep` of `level` (with data `data`) as a mesh of their own, and the index of each
-/// kept face in it (`u32::MAX` for the others). The cut around them becomes a boundary
+/// The faces `keep` (sorted) of `level` (with data `data`) as a mesh of their own, in which
+/// kept face `k` is face `k` ([`local_face`]). The cut around them becomes a boundary
 /// (infinitely sharp): it changes only points that the kept faces' inner limit surface does not
 /// depend on.
-fn extract(
-    level: &Level,
-    data: &[VertexData],
-    keep: &[u32],
-) -> Option<(Level, Vec<VertexData>, Vec<u32>)> {
+fn extract(level: &Level, data: &[VertexData], keep: &[u32]) -> Option<(Level, Vec<VertexData>)> {
     let t = &level.topology;
-    let mut vertex_map = vec![u32::MAX; t.vertex_count()];
-    let mut face_map = vec![u32::MAX; t.face_count()];
     let mut vertices: Vec<u32> = Vec::new();
-    let faces: Vec<Vec<u32>> = keep
-        .iter()
-        .enumerate()
-        .map(|(k, &g)| {
-            face_map[g as usize] = k as u32;
-            t.face_vertices(g as usize)
-                .iter()
-                .map(|&v| {
-                    if vertex_map[v as usize] == u32::MAX {
-                        vertex_map[v as usize] = vertices.len() as u32;
-                        vertices.push(v);
-                    }
-                    vertex_map[v as usize]
-                })
-                .collect()
-        })
-        .collect();
+    let faces: Vec<Vec<u32>> = VERTEX_MAP.with(|cell| {
+        let mut vertex_map = cell.borrow_mut();
+        if vertex_map.len() < t.vertex_count() {
+            vertex_map.resize(t.vertex_count(), u32::MAX);
+        }
+        let faces = keep
+            .iter()
+            .map(|&g| {
+                t.face_vertices(g as usize)
+                    .iter()
+                    .map(|&v| {
+                        if vertex_map[v as usize] == u32::MAX {
+                            vertex_map[v as usize] = vertices.len() as u32;
+                            vertices.push(v);
+                        }
+                        vertex_map[v as usize]
+                    })
+                    .collect()
+            })
+            .collect();
+        for &v in &vertices {
+            vertex_map[v as usize] = u32::MAX;
+        }
+        faces
+    });
     let topology = Topology::from_faces(vertices.len(), &faces).ok()?;
     let edge_sharpness = (0..topology.edge_count())
         .map(|e| {
@@ -336,7 +338,20 @@ fn extract(
         BoundaryInterpolation::EdgeOnly,
     );
     let local_data = vertices.iter().map(|&v| data[v as usize]).collect();
-    Some((local, local_data, face_map))
+    Some((local, local_data))
+}
+
+thread_local! {
+    /// [`extract`]'s map from a level's vertices to the neighbourhood's, all `u32::MAX`
+    /// between calls: allocated once per thread, so that cutting a face's neighbourhood out of
+    /// a large level costs the neighbourhood's size, not the level's (it was two arrays the
+    /// size of the whole level per irregular face).
+    static VERTEX_MAP: std::cell::RefCell<Vec<u32>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// The index of face `g` of a level among the faces `keep` (sorted) cut out of it.
+fn local_face(keep: &[u32], g: u32) -> u32 {
+    keep.binary_search(&g).expect("a kept face") as u32
 }
 
 /// The faces of `t` that share a vertex with one of `tiles`, in increasing order.
@@ -365,9 +380,9 @@ impl LocalPatch {
             v: [0, 1],
         };
         let keep = neighbourhood(&level.topology, &[whole]);
-        let (local, local_data, map) = extract(level, data, &keep)?;
+        let (local, local_data) = extract(level, data, &keep)?;
         let tiles = vec![Tile {
-            face: map[f],
+            face: local_face(&keep, f as u32),
             ..whole
         }];
         Some(LocalPatch {
@@ -417,9 +432,9 @@ impl LocalPatch {
             }
         }
         let keep = neighbourhood(&child.topology, &tiles);
-        let (level, data, map) = extract(&child, &child_data, &keep)?;
+        let (level, data) = extract(&child, &child_data, &keep)?;
         for tile in &mut tiles {
-            tile.face = map[tile.face as usize];
+            tile.face = local_face(&keep, tile.face);
         }
         self.levels.push(LocalLevel { level, data, tiles });
         Some(())
