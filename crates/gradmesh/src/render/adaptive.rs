@@ -774,7 +774,7 @@ mod tests {
         let mut cursor = tess.triangles.cursor();
         for i in 0..tess.triangles.len() {
             let t = cursor.get(i);
-            t.for_each_span(t.rows.0.max(0)..t.rows.1.min(h), w, |j, a, b| {
+            t.for_each_span(t.rows().0.max(0)..t.rows().1.min(h), w, |j, a, b| {
                 for x in a..b {
                     hits[(j * w + x) as usize] += 1;
                 }

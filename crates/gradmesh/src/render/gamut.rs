@@ -108,10 +108,10 @@ pub(crate) fn to_blend_space(
     }
 }
 
-/// [`to_blend_space`] in single precision for the per-pixel loop: Lab and sRGB colours inside
-/// the gamut (most pixels) stay in `f32`, with the table of [`srgb_encode_f32`]; every other
-/// colour goes through [`to_blend_space`]. Single precision keeps about 7 digits, far below a
-/// 16-bit output step.
+/// [`to_blend_space`] in single precision: Lab and sRGB colours inside the gamut (most pixels)
+/// stay in `f32`, with the table of [`srgb_encode_f32`]; every other colour goes through
+/// [`to_blend_space`]. Single precision keeps about 7 digits, far below a 16-bit output step.
+/// The per-pixel loop converts whole runs with [`RunConverter`], which gives the same bits.
 #[inline]
 pub(crate) fn to_blend_space_f32(
     space: ColourSpace,
@@ -124,36 +124,116 @@ pub(crate) fn to_blend_space_f32(
         return c;
     }
     if space == ColourSpace::Lab {
-        let lin = lab_to_linear_srgb_f32(c);
+        let lin = lab_to_linear_srgb_f32(lab_matrix_f32(), c);
         if in_unit(&lin) {
             return match blend {
                 BlendSpace::Linear => lin,
-                BlendSpace::Srgb => [
-                    srgb_encode_f32(lin[0]),
-                    srgb_encode_f32(lin[1]),
-                    srgb_encode_f32(lin[2]),
-                ],
+                BlendSpace::Srgb => lin.map(srgb_encode_f32),
             };
         }
     }
+    to_blend_space_wide(space, c, gamut, blend)
+}
+
+/// [`to_blend_space`] of a single-precision colour.
+fn to_blend_space_wide(
+    space: ColourSpace,
+    c: [f32; 3],
+    gamut: GamutMapping,
+    blend: BlendSpace,
+) -> [f32; 3] {
     let wide = to_blend_space(space, [c[0] as f64, c[1] as f64, c[2] as f64], gamut, blend);
     [wide[0] as f32, wide[1] as f32, wide[2] as f32]
 }
 
-/// [`lab_to_linear_srgb`] in single precision (the same matrix, rounded).
-#[inline]
-fn lab_to_linear_srgb_f32(c: [f32; 3]) -> [f32; 3] {
+/// Colours per run of [`RunConverter::convert`].
+pub(crate) const RUN: usize = 64;
+
+/// [`to_blend_space_f32`] for runs of up to [`RUN`] colours of one layer, with the same bits:
+/// the colours come as one array per channel, so that the Lab part is a loop over whole
+/// arrays the compiler turns into vector instructions, and the tables are looked up once per
+/// run instead of once per pixel.
+pub(crate) struct RunConverter {
+    space: ColourSpace,
+    gamut: GamutMapping,
+    blend: BlendSpace,
+    matrix: &'static [[f32; 3]; 3],
+    table: &'static [f32],
+}
+
+impl RunConverter {
+    pub fn new(space: ColourSpace, gamut: GamutMapping, blend: BlendSpace) -> RunConverter {
+        RunConverter {
+            space,
+            gamut,
+            blend,
+            matrix: lab_matrix_f32(),
+            table: encode_table_f32(),
+        }
+    }
+
+    /// Converts the first `n` colours of `c` (channel `k` of colour `m` at `c[k][m]`) into
+    /// `out[m]`.
+    #[inline]
+    pub fn convert(&self, c: &[[f32; RUN]; 3], n: usize, out: &mut [[f32; 3]; RUN]) {
+        let n = n.min(RUN);
+        let in_unit = |v: &[f32; 3]| v.iter().all(|x| (0.0..=1.0).contains(x));
+        if self.space != ColourSpace::Lab {
+            for m in 0..n {
+                let colour = [c[0][m], c[1][m], c[2][m]];
+                out[m] = to_blend_space_f32(self.space, colour, self.gamut, self.blend);
+            }
+            return;
+        }
+        // Every lane, used or not: a fixed trip count over whole arrays vectorises.
+        let mut lin = [[0.0f32; RUN]; 3];
+        for m in 0..RUN {
+            let l = lab_to_linear_srgb_f32(self.matrix, [c[0][m], c[1][m], c[2][m]]);
+            for k in 0..3 {
+                lin[k][m] = l[k];
+            }
+        }
+        for m in 0..n {
+            let l = [lin[0][m], lin[1][m], lin[2][m]];
+            out[m] = if !in_unit(&l) {
+                to_blend_space_wide(
+                    self.space,
+                    [c[0][m], c[1][m], c[2][m]],
+                    self.gamut,
+                    self.blend,
+                )
+            } else {
+                match self.blend {
+                    BlendSpace::Linear => l,
+                    BlendSpace::Srgb => l.map(|v| srgb_encode_f32_with(self.table, v)),
+                }
+            };
+        }
+    }
+}
+
+/// The matrix of [`lab_to_linear_srgb`], rounded to single precision.
+fn lab_matrix_f32() -> &'static [[f32; 3]; 3] {
     static MATRIX: std::sync::OnceLock<[[f32; 3]; 3]> = std::sync::OnceLock::new();
-    let m = MATRIX.get_or_init(|| lab_matrix().map(|row| row.map(|v| v as f32)));
+    MATRIX.get_or_init(|| lab_matrix().map(|row| row.map(|v| v as f32)))
+}
+
+/// [`lab_to_linear_srgb`] in single precision, with the matrix `m` of [`lab_matrix_f32`].
+/// Without branches (both pieces of the inverse Lab function are computed, and one chosen),
+/// so that a loop over many colours vectorises.
+#[inline(always)]
+fn lab_to_linear_srgb_f32(m: &[[f32; 3]; 3], c: [f32; 3]) -> [f32; 3] {
     // Products by reciprocals: a rounding apart from the quotients, a division's time less.
     let fy = (c[0] + 16.0) * (1.0 / 116.0);
     let fx = fy + c[1] * (1.0 / 500.0);
     let fz = fy - c[2] * (1.0 / 200.0);
     let finv = |t: f32| {
+        let cube = t * t * t;
+        let linear = 3.0 * (6.0f32 / 29.0) * (6.0f32 / 29.0) * (t - 4.0 / 29.0);
         if t > 6.0 / 29.0 {
-            t * t * t
+            cube
         } else {
-            3.0 * (6.0f32 / 29.0) * (6.0f32 / 29.0) * (t - 4.0 / 29.0)
+            linear
         }
     };
     let (x, y, z) = (finv(fx), finv(fy), finv(fz));
@@ -266,6 +346,12 @@ fn encode_table_f32() -> &'static [f32] {
 /// step), the linear segment below, and [`srgb_encode`] outside `0..=1`.
 #[inline]
 pub(crate) fn srgb_encode_f32(linear: f32) -> f32 {
+    srgb_encode_f32_with(encode_table_f32(), linear)
+}
+
+/// [`srgb_encode_f32`] with its `table` ([`encode_table_f32`]) at hand.
+#[inline(always)]
+fn srgb_encode_f32_with(table: &[f32], linear: f32) -> f32 {
     if linear <= 0.003_130_8 || linear >= 1.0 {
         return if (0.0..=1.0).contains(&linear) {
             if linear == 1.0 {
@@ -285,8 +371,7 @@ pub(crate) fn srgb_encode_f32(linear: f32) -> f32 {
     let step = (mantissa >> shift) as usize;
     let frac = (mantissa & ((1 << shift) - 1)) as f32 / (1u32 << shift) as f32;
     let i = (exponent + ENCODE_OCTAVES as i32) as usize * ENCODE_STEPS_F32 as usize + step;
-    let t = encode_table_f32();
-    t[i] + frac * (t[i + 1] - t[i])
+    table[i] + frac * (table[i + 1] - table[i])
 }
 
 fn in_gamut(rgb: [f64; 3], tolerance: f64) -> bool {
@@ -482,6 +567,69 @@ mod tests {
             }
         }
         assert!(worst < 5e-6, "worst {worst}");
+    }
+
+    /// The run converter gives the bits of the per-colour conversion, in every space and blend
+    /// space, for colours inside and outside the gamut, and for partial runs.
+    #[test]
+    fn run_conversion_matches_single_colours() {
+        let mut seed = 0x853c_49e6_748f_ea9b_u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f32 / (1u64 << 53) as f32
+        };
+        let spaces = [
+            ColourSpace::Lab,
+            ColourSpace::Srgb,
+            ColourSpace::SrgbLinear,
+            ColourSpace::Oklab,
+        ];
+        for space in spaces {
+            for blend in [BlendSpace::Srgb, BlendSpace::Linear] {
+                for gamut in [GamutMapping::Clip, GamutMapping::Chroma] {
+                    let convert = RunConverter::new(space, gamut, blend);
+                    for n in [RUN, 1, 17] {
+                        let mut c = [[0.0f32; RUN]; 3];
+                        for m in 0..RUN {
+                            // Lab-sized values, and unit-sized ones (some just outside 0..1).
+                            let colour = if space == ColourSpace::Lab {
+                                [
+                                    110.0 * next() - 5.0,
+                                    260.0 * next() - 130.0,
+                                    260.0 * next() - 130.0,
+                                ]
+                            } else {
+                                [1.2 * next() - 0.1, 1.2 * next() - 0.1, 1.2 * next() - 0.1]
+                            };
+                            for k in 0..3 {
+                                c[k][m] = colour[k];
+                            }
+                        }
+                        let mut out = [[f32::NAN; 3]; RUN];
+                        convert.convert(&c, n, &mut out);
+                        for m in 0..n {
+                            let one = to_blend_space_f32(
+                                space,
+                                [c[0][m], c[1][m], c[2][m]],
+                                gamut,
+                                blend,
+                            );
+                            assert_eq!(
+                                out[m].map(f32::to_bits),
+                                one.map(f32::to_bits),
+                                "{space:?} {m}"
+                            );
+                        }
+                        assert!(
+                            out[n..].iter().flatten().all(|v| v.is_nan()),
+                            "wrote past the run"
+                        );
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -539,7 +539,8 @@ pub(super) fn screen_triangle_px(
         return None;
     }
     let tri = Triangle::new(v, exact, attr)?;
-    (tri.rows.1 > 0 && tri.rows.0 < h && tri.rows.0 < tri.rows.1).then_some(tri)
+    let rows = tri.rows();
+    (rows.1 > 0 && rows.0 < h && rows.0 < rows.1).then_some(tri)
 }
 
 /// The uniform path's triangles: every quad of level `t` with the limit data `lim` at its
@@ -680,8 +681,8 @@ pub(crate) fn prepare(
         .iter()
         .enumerate()
         .map(|(i, tri)| {
-            let a = tri.rows.0.max(0) as usize / BAND;
-            let b = (tri.rows.1.min(h) - 1) as usize / BAND;
+            let a = tri.rows().0.max(0) as usize / BAND;
+            let b = (tri.rows().1.min(h) - 1) as usize / BAND;
             (i as u32, a, b)
         })
         .collect();

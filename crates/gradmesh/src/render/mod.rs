@@ -110,6 +110,7 @@ pub use output::{encode_png, encode_png_rgba16, encode_png_rgba8, Image, OutputP
 pub use overlay::draw_outlines;
 pub use view::{document_bounds, View};
 
+use gamut::RUN;
 use layer::{PreparedLayer, BAND};
 use view::ToPixels;
 
@@ -533,6 +534,8 @@ struct Scratch {
     opaque: Vec<bool>,
     accumulation: Vec<f64>,
     coverage: Vec<f32>,
+    /// The pixels of a run that a layer shows, before and after conversion to the blend space.
+    run: Box<Run>,
     /// Premultiplied colour in the blend space. Single precision: compositing a few layers
     /// loses far less than a 16-bit step, and half the bytes keep a wide band in cache.
     colour: Vec<[f32; 4]>,
@@ -576,8 +579,24 @@ impl Scratch {
             accumulation: vec![0.0; (w + 2) * BAND],
             coverage: vec![0.0; w],
             colour: vec![[0.0; 4]; w * BAND],
+            run: Box::new(Run {
+                colour: [[0.0; RUN]; 3],
+                pixel: [0; RUN],
+                alpha: [0.0; RUN],
+                rgb: [[0.0; 3]; RUN],
+            }),
         }
     }
+}
+
+/// Up to [`RUN`] pixels of a row that one layer shows: their working-space colours (one array
+/// per channel, for [`gamut::RunConverter`]), where they go, their opacity, and their colours
+/// in the blend space.
+struct Run {
+    colour: [[f32; RUN]; 3],
+    pixel: [u32; RUN],
+    alpha: [f32; RUN],
+    rgb: [[f32; 3]; RUN],
 }
 
 /// Draws rows `band * BAND ..` of every layer into `out`.
@@ -609,13 +628,15 @@ fn draw_band<P: OutputPixel>(
             continue;
         }
         let (c0, c1) = layer.columns;
+        let converter = gamut::RunConverter::new(layer.space, opts.gamut, opts.blend);
         for r in 0..rows {
             s.covered[r * w + c0..r * w + c1].fill(false);
         }
         let mut cursor = layer.triangles.cursor();
         for &ti in tris {
             let t = cursor.get(ti as usize);
-            let (j0, j1) = (t.rows.0.max(y0 as i64), t.rows.1.min((y0 + rows) as i64));
+            let (r0, r1) = t.rows();
+            let (j0, j1) = (r0.max(y0 as i64), r1.min((y0 + rows) as i64));
             t.for_each_span(j0..j1, w as i64, |j, a, b| {
                 let (a, b) = ((a as usize).max(c0), (b as usize).min(c1));
                 if a >= b {
@@ -647,40 +668,52 @@ fn draw_band<P: OutputPixel>(
                 &mut s.coverage[c0..c1],
             );
             let y = (y0 + r) as f64 + 0.5;
-            for i in c0..c1 {
-                let cov = s.coverage[i];
-                let k = r * w + i;
-                if cov == 0.0 || s.opaque[k] {
-                    continue;
-                }
-                let attr = if s.covered[k] {
-                    s.attributes[k]
-                } else {
-                    match layer.nearest.attributes_at([i as f64 + 0.5, y]) {
-                        Some(a) => a,
-                        None => continue,
+            // In runs: first the pixels this layer shows, then their colours all at once
+            // (vectorised), then compositing.
+            let mut i = c0;
+            while i < c1 {
+                let run = &mut s.run;
+                let mut n = 0;
+                while i < c1 && n < RUN {
+                    let cov = s.coverage[i];
+                    let k = r * w + i;
+                    i += 1;
+                    if cov == 0.0 || s.opaque[k] {
+                        continue;
                     }
-                };
-                let alpha = cov * attr[3].clamp(0.0, 1.0);
-                if alpha <= 0.0 {
-                    continue;
+                    let attr = if s.covered[k] {
+                        s.attributes[k]
+                    } else {
+                        match layer.nearest.attributes_at([(i - 1) as f64 + 0.5, y]) {
+                            Some(a) => a,
+                            None => continue,
+                        }
+                    };
+                    let alpha = cov * attr[3].clamp(0.0, 1.0);
+                    if alpha <= 0.0 {
+                        continue;
+                    }
+                    for c in 0..3 {
+                        run.colour[c][n] = attr[c];
+                    }
+                    run.alpha[n] = alpha;
+                    run.pixel[n] = k as u32;
+                    n += 1;
                 }
-                let rgb = gamut::to_blend_space_f32(
-                    layer.space,
-                    [attr[0], attr[1], attr[2]],
-                    opts.gamut,
-                    opts.blend,
-                );
-                let dst = &mut colour[k];
-                let weight = alpha * (1.0 - dst[3]);
-                for c in 0..3 {
-                    dst[c] += rgb[c] * weight;
-                }
-                // a + (1 - a) is 1, but not always in floating point.
-                dst[3] = if alpha >= 1.0 { 1.0 } else { dst[3] + weight };
-                if dst[3] >= 1.0 {
-                    s.opaque[k] = true;
-                    opaque += 1;
+                converter.convert(&run.colour, n, &mut run.rgb);
+                for m in 0..n {
+                    let (k, alpha, rgb) = (run.pixel[m] as usize, run.alpha[m], run.rgb[m]);
+                    let dst = &mut colour[k];
+                    let weight = alpha * (1.0 - dst[3]);
+                    for c in 0..3 {
+                        dst[c] += rgb[c] * weight;
+                    }
+                    // a + (1 - a) is 1, but not always in floating point.
+                    dst[3] = if alpha >= 1.0 { 1.0 } else { dst[3] + weight };
+                    if dst[3] >= 1.0 {
+                        s.opaque[k] = true;
+                        opaque += 1;
+                    }
                 }
             }
         }

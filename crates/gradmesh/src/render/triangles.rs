@@ -55,19 +55,28 @@ impl Edge {
 }
 
 /// A positively oriented triangle with four attributes varying linearly over it.
+///
+/// Kept small (104 bytes): a dense layer has tens of thousands of triangles, written once and
+/// read once per band, and the fresh pages they take cost more than building them.
 #[derive(Clone, Debug)]
 pub(crate) struct Triangle {
     /// Snapped vertices, positively oriented.
     v: [[i64; 2]; 3],
-    /// First row and one past the last row whose centres may lie inside.
-    pub rows: (i64, i64),
-    /// Whether every vertex lies within [`SMALL`] of the origin.
-    small: bool,
-    /// Attribute values are `base + gx * x + gy * y` at pixel coordinates (x, y).
-    base: [f64; 4],
-    gx: [f64; 4],
-    gy: [f64; 4],
+    /// First row and one past the last row whose centres may lie inside, clamped to
+    /// [`ROW_CLAMP`] (far beyond any image).
+    rows: [i32; 2],
+    /// Attribute values are `at_origin + gx * (x - ox) + gy * (y - oy)` at pixel coordinates
+    /// (x, y), where the origin (ox, oy) is the pixel corner at or below the first vertex (see
+    /// [`Triangle::origin`]). Relative to a nearby integer origin, single precision keeps
+    /// about 7 digits of the colour even far from the image's origin, and a row is filled in
+    /// single precision.
+    at_origin: [f32; 4],
+    gx: [f32; 4],
+    gy: [f32; 4],
 }
+
+/// Rows are kept within this magnitude: images are at most 2^16 rows tall.
+const ROW_CLAMP: i64 = 1 << 30;
 
 /// Triangles in drawing order, kept in the chunks they were built in (one per face on the
 /// fast path): concatenating them would write every triangle to fresh memory a second time,
@@ -179,51 +188,75 @@ impl Triangle {
         if area2 < 0 {
             v.swap(1, 2);
         }
-        let small = v.iter().flatten().all(|c| c.abs() < SMALL);
         let ymin = v.iter().map(|p| p[1]).min().expect("three vertices");
         let ymax = v.iter().map(|p| p[1]).max().expect("three vertices");
         let half = SUBPIXEL / 2;
         // Snapped coordinates are under 2^40: 64 bits hold this.
-        let rows = (
-            -((half - ymin).div_euclid(SUBPIXEL)),
-            (ymax - half).div_euclid(SUBPIXEL) + 1,
-        );
+        let clamp = |r: i64| r.clamp(-ROW_CLAMP, ROW_CLAMP) as i32;
+        let rows = [
+            clamp(-((half - ymin).div_euclid(SUBPIXEL))),
+            clamp((ymax - half).div_euclid(SUBPIXEL) + 1),
+        ];
+        let origin = Self::origin_of(&v);
 
         // Plane of each attribute, in pixel units, through the exact positions (a triangle
         // that snapping left with area may have none exactly: then keep the mean value).
         let [a, b, c] = exact;
         let (e1, e2) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
         let det = e1[0] * e2[1] - e1[1] * e2[0];
-        let mut base = [0.0; 4];
+        let mut at_origin = [0.0; 4];
         let mut gx = [0.0; 4];
         let mut gy = [0.0; 4];
         if det == 0.0 || !det.is_finite() {
             for k in 0..4 {
-                base[k] = (attr[0][k] + attr[1][k] + attr[2][k]) / 3.0;
+                at_origin[k] = ((attr[0][k] + attr[1][k] + attr[2][k]) / 3.0) as f32;
             }
-            return Some(Triangle {
-                v,
-                rows,
-                small,
-                base,
-                gx,
-                gy,
-            });
-        }
-        for k in 0..4 {
-            let (d1, d2) = (attr[1][k] - attr[0][k], attr[2][k] - attr[0][k]);
-            gx[k] = (d1 * e2[1] - d2 * e1[1]) / det;
-            gy[k] = (d2 * e1[0] - d1 * e2[0]) / det;
-            base[k] = attr[0][k] - gx[k] * a[0] - gy[k] * a[1];
+        } else {
+            // From the first vertex, which lies within a pixel of the origin.
+            let (dx, dy) = (origin[0] - a[0], origin[1] - a[1]);
+            for k in 0..4 {
+                let (d1, d2) = (attr[1][k] - attr[0][k], attr[2][k] - attr[0][k]);
+                let (sx, sy) = (
+                    (d1 * e2[1] - d2 * e1[1]) / det,
+                    (d2 * e1[0] - d1 * e2[0]) / det,
+                );
+                at_origin[k] = (attr[0][k] + sx * dx + sy * dy) as f32;
+                gx[k] = sx as f32;
+                gy[k] = sy as f32;
+            }
         }
         Some(Triangle {
             v,
             rows,
-            small,
-            base,
+            at_origin,
             gx,
             gy,
         })
+    }
+
+    /// The first row and one past the last whose pixel centres may lie inside.
+    #[inline]
+    pub fn rows(&self) -> (i64, i64) {
+        (self.rows[0] as i64, self.rows[1] as i64)
+    }
+
+    /// The pixel corner at or below (in both coordinates) the first vertex.
+    #[inline]
+    fn origin(&self) -> [f64; 2] {
+        Self::origin_of(&self.v)
+    }
+
+    fn origin_of(v: &[[i64; 2]; 3]) -> [f64; 2] {
+        [
+            v[0][0].div_euclid(SUBPIXEL) as f64,
+            v[0][1].div_euclid(SUBPIXEL) as f64,
+        ]
+    }
+
+    /// Whether every vertex lies within [`SMALL`] of the origin.
+    #[inline]
+    fn small(&self) -> bool {
+        self.v.iter().flatten().all(|c| c.abs() < SMALL)
     }
 
     fn edges(&self) -> [Edge; 3] {
@@ -239,7 +272,9 @@ impl Triangle {
     /// `0..width`.
     #[cfg(test)]
     pub fn span(&self, j: i64, width: i64) -> (i64, i64) {
-        self.span_with(&self.edges(), j, width)
+        let mut span = (0, 0);
+        self.for_each_span(j..j + 1, width, |_, a, b| span = (a, b));
+        span
     }
 
     /// Calls `f(j, start, end)` with the columns inside for each row `j` in `rows`, finding
@@ -252,18 +287,14 @@ impl Triangle {
         mut f: impl FnMut(i64, i64, i64),
     ) {
         let edges = self.edges();
+        let small = self.small();
         for j in rows {
-            let (a, b) = self.span_with(&edges, j, width);
+            let (a, b) = if small && j.abs() < SMALL_ROWS {
+                Self::span_small(&edges, j, width)
+            } else {
+                Self::span_wide(&edges, j, width)
+            };
             f(j, a, b);
-        }
-    }
-
-    #[inline]
-    fn span_with(&self, edges: &[Edge; 3], j: i64, width: i64) -> (i64, i64) {
-        if self.small && j.abs() < SMALL_ROWS {
-            Self::span_small(edges, j, width)
-        } else {
-            Self::span_wide(edges, j, width)
         }
     }
 
@@ -352,14 +383,20 @@ impl Triangle {
         self.fill_row(y, x, &mut [[0.0; 4]])[0]
     }
 
-    /// Writes the attributes at the pixel centres `x0, x0 + 1, ..` of row `y` into `out`:
-    /// the row's constant part once, then one multiply-add per attribute and pixel.
+    /// Writes the attributes at the pixel centres `x0, x0 + 1, ..` of row `y` (pixel
+    /// coordinates of the centres) into `out`: the row's constant part once, then one
+    /// multiply-add per attribute and pixel, in single precision.
     #[inline]
     pub fn fill_row<'a>(&self, y: f64, x0: f64, out: &'a mut [[f32; 4]]) -> &'a [[f32; 4]] {
-        let row: [f64; 4] = std::array::from_fn(|k| self.base[k] + self.gy[k] * y);
-        for (n, o) in out.iter_mut().enumerate() {
-            let x = x0 + n as f64;
-            *o = std::array::from_fn(|k| (row[k] + self.gx[k] * x) as f32);
+        let o = self.origin();
+        // Exact while the row lies within 2^23 pixels of the origin (a triangle with a vertex
+        // near the image); farther, the rounding is a fraction of the gradient's change over
+        // the triangle.
+        let (dy, dx0) = ((y - o[1]) as f32, (x0 - o[0]) as f32);
+        let row: [f32; 4] = std::array::from_fn(|k| self.at_origin[k] + self.gy[k] * dy);
+        for (n, out) in out.iter_mut().enumerate() {
+            let dx = dx0 + n as f32;
+            *out = std::array::from_fn(|k| row[k] + self.gx[k] * dx);
         }
         out
     }
@@ -410,7 +447,7 @@ mod tests {
     fn count(tris: &[Triangle], w: i64, h: i64) -> Vec<u32> {
         let mut hits = vec![0u32; (w * h) as usize];
         for t in tris {
-            for j in t.rows.0.max(0)..t.rows.1.min(h) {
+            for j in t.rows().0.max(0)..t.rows().1.min(h) {
                 let (a, b) = t.span(j, w);
                 for i in a..b {
                     hits[(j * w + i) as usize] += 1;
@@ -516,7 +553,7 @@ mod tests {
         for stride in [1, 2, 3, 5, 11] {
             let mut cursor = list.cursor();
             for i in (0..list.len()).step_by(stride) {
-                assert_eq!(cursor.get(i).base[0], (i + 1) as f64);
+                assert_eq!(cursor.get(i).at_origin[0], (i + 1) as f32);
             }
         }
     }
@@ -558,13 +595,43 @@ mod tests {
             let Some(t) = Triangle::new(v, [[0.0; 2]; 3], [[0.0; 4]; 3]) else {
                 continue;
             };
-            assert!(t.small);
-            for j in t.rows.0 - 1..=t.rows.1 {
+            assert!(t.small());
+            for j in t.rows().0 - 1..=t.rows().1 {
                 let e = t.edges();
                 assert_eq!(
                     Triangle::span_small(&e, j, 600),
                     Triangle::span_wide(&e, j, 600)
                 );
+            }
+        }
+    }
+
+    /// Far from the image's origin and on a steep gradient, the single-precision attributes
+    /// (relative to an integer origin by the first vertex) stay within a millionth of the
+    /// attributes' range of the exact plane.
+    #[test]
+    fn attributes_stay_exact_far_from_the_origin() {
+        for (x0, y0) in [(0.0, 0.0), (3000.37, 2047.9), (-1234.5, 60_000.25)] {
+            let exact = [[x0, y0], [x0 + 7.3, y0 + 0.4], [x0 + 1.1, y0 + 5.9]];
+            let attr = [
+                [20.0, -40.0, 60.0, 1.0],
+                [90.0, 35.0, -70.0, 0.5],
+                [55.0, 120.0, 10.0, 0.0],
+            ];
+            let t = Triangle::new(exact.map(|q| p(q[0], q[1])), exact, attr).unwrap();
+            for (u, v) in [(0.2, 0.3), (0.5, 0.1), (0.05, 0.9)] {
+                let x = exact[0][0] + u * 7.3 + v * 1.1;
+                let y = exact[0][1] + u * 0.4 + v * 5.9;
+                let got = t.eval(x, y);
+                for k in 0..4 {
+                    let want =
+                        attr[0][k] + u * (attr[1][k] - attr[0][k]) + v * (attr[2][k] - attr[0][k]);
+                    assert!(
+                        (got[k] as f64 - want).abs() < 2e-4,
+                        "{x0} {k}: {} {want}",
+                        got[k]
+                    );
+                }
             }
         }
     }
