@@ -38,6 +38,7 @@ use super::nearest::Segment;
 use super::patches::{regular_corners, regular_patch_with, ControlGrid, Grid, LocalPatch};
 use super::triangles::{snap, Triangle, TriangleList};
 use super::view::ToPixels;
+use super::{each3, each4};
 
 /// The level whose faces get their own density: all quads, extraordinary vertices isolated,
 /// and faces small enough that irregular ones (refined locally) cover little of the layer.
@@ -252,15 +253,15 @@ fn measure_grid(
     };
     let mut m = Measure::default();
     for c in cells {
-        let sides = [0, 1, 2, 3].map(|k| (c[k], c[(k + 1) % 4]));
+        let sides = each4(|k| (c[k], c[(k + 1) % 4]));
         let q = QuadSamples {
-            corners: c.map(at),
+            corners: each4(|k| at(c[k])),
             centre: mid(c[0], c[2]),
-            mids: sides.map(|(a, b)| mid(a, b)),
-            boundary: sides.map(|(a, b)| on_side(a, b)),
+            mids: each4(|k| mid(sides[k].0, sides[k].1)),
+            boundary: each4(|k| on_side(sides[k].0, sides[k].1)),
             jacobians: jacobians.as_ref().map(|_| {
                 let centre = jac(c[0], c[2]).expect("jacobians present");
-                let mids = sides.map(|(a, b)| jac(a, b).expect("jacobians present"));
+                let mids = each4(|k| jac(sides[k].0, sides[k].1).expect("jacobians present"));
                 [centre, mids[0], mids[1], mids[2], mids[3]]
             }),
         };
@@ -321,9 +322,8 @@ pub(super) fn tessellate(
     let n_max = 1usize << (max_level.max(k0) - k0).min(12);
     let passes =
         |m: &Measure| m.extent <= th.quad && m.colour <= th.colour && m.outline <= th.outline;
-    let boundary_sides = |f: usize| -> [bool; 4] {
-        [0, 1, 2, 3].map(|k| t.is_boundary_edge(t.face_edges(f)[k] as usize))
-    };
+    let boundary_sides =
+        |f: usize| -> [bool; 4] { each4(|k| t.is_boundary_edge(t.face_edges(f)[k] as usize)) };
 
     let regular = regular_corners(level);
 
@@ -561,7 +561,7 @@ pub(super) fn tessellate(
         let m = plan.n;
         let (fv, fe) = (t.face_vertices(f), t.face_edges(f));
         // Extra samples per cell side along each face side.
-        let ratio = [0, 1, 2, 3].map(|k| edge_cells[fe[k] as usize] / m);
+        let ratio = each4(|k| edge_cells[fe[k] as usize] / m);
         // The face side, and the position along it, of grid point (i, j), if it has one.
         let on_side = |k: usize, (i, j): (usize, usize)| -> Option<usize> {
             match k {
@@ -580,12 +580,12 @@ pub(super) fn tessellate(
         let mut polygon: Vec<&VertexData> = Vec::new();
         for cell in orders.get(m) {
             // Which cell sides lie along a face side with extra samples.
-            let refined = [0, 1, 2, 3].map(|c| {
+            let refined = each4(|c| {
                 let (a, b) = (cell[c], cell[(c + 1) % 4]);
                 (0..4).find(|&k| ratio[k] > 1 && on_side(k, a).is_some() && on_side(k, b).is_some())
             });
             if refined.iter().all(Option::is_none) {
-                let q = cell.map(sample);
+                let q = each4(|k| sample(cell[k]));
                 push([q[0], q[1], q[2]]);
                 push([q[0], q[2], q[3]]);
                 continue;
@@ -692,8 +692,10 @@ fn turn_flags(g: &[VertexData], n: usize) -> u8 {
     let mut flags = 0;
     for j in 0..n {
         for i in 0..n {
-            let [a, b, c, d] =
-                [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)].map(|(x, y)| &g[y * s + x]);
+            let [a, b, c, d] = each4(|k| {
+                let (x, y) = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)][k];
+                &g[y * s + x]
+            });
             // Twice the signed area of the quad: the cross product of its diagonals.
             let cross = (c[0] - a[0]) * (d[1] - b[1]) - (c[1] - a[1]) * (d[0] - b[0]);
             if cross > 0.0 {
@@ -709,8 +711,8 @@ fn turn_flags(g: &[VertexData], n: usize) -> u8 {
 /// The triangle through three limit samples, in pixels, if it may cover a pixel centre of the
 /// image (see [`super::layer::screen_triangle_px`]).
 fn screen_triangle(d: [&VertexData; 3], xf: &ToPixels, size: (i64, i64)) -> Option<Triangle> {
-    let exact = d.map(|d| xf.apply(d[0], d[1]));
-    let attr = d.map(|d| [d[2], d[3], d[4], d[5]]);
+    let exact = each3(|k| xf.apply(d[k][0], d[k][1]));
+    let attr = each3(|k| [d[k][2], d[k][3], d[k][4], d[k][5]]);
     super::layer::screen_triangle_px(exact, attr, size)
 }
 

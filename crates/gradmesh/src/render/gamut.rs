@@ -128,7 +128,11 @@ pub(crate) fn to_blend_space_f32(
         if in_unit(&lin) {
             return match blend {
                 BlendSpace::Linear => lin,
-                BlendSpace::Srgb => lin.map(srgb_encode_f32),
+                BlendSpace::Srgb => [
+                    srgb_encode_f32(lin[0]),
+                    srgb_encode_f32(lin[1]),
+                    srgb_encode_f32(lin[2]),
+                ],
             };
         }
     }
@@ -203,9 +207,11 @@ impl RunConverter {
                     self.blend,
                 )
             } else {
+                // Written out: `array::map` with a closure stayed a chain of calls here.
+                let encode = |v| srgb_encode_f32_with(self.table, v);
                 match self.blend {
                     BlendSpace::Linear => l,
-                    BlendSpace::Srgb => l.map(|v| srgb_encode_f32_with(self.table, v)),
+                    BlendSpace::Srgb => [encode(l[0]), encode(l[1]), encode(l[2])],
                 }
             };
         }

@@ -19,7 +19,7 @@ use super::nearest::{NearestSegments, Segment};
 use super::outline::{boundary_loops, outline};
 use super::triangles::{snap, Triangle, TriangleList, SUBPIXEL};
 use super::view::ToPixels;
-use super::{LayerInfo, LayerTimings, RenderOptions};
+use super::{each3, each4, LayerInfo, LayerTimings, RenderOptions};
 
 /// Rows per band: the unit of parallel work.
 pub(crate) const BAND: usize = 16;
@@ -204,8 +204,7 @@ fn interpolate(p: [[f64; 2]; 3], c: [[f64; 4]; 3], x: [f64; 2]) -> [f64; 4] {
         let u = (dx * e2[1] - dy * e2[0]) / det;
         let v = (e1[0] * dy - e1[1] * dx) / det;
         if u >= 0.0 && v >= 0.0 && u + v <= 1.0 {
-            return [0, 1, 2, 3]
-                .map(|k| c[0][k] + u * (c[1][k] - c[0][k]) + v * (c[2][k] - c[0][k]));
+            return each4(|k| c[0][k] + u * (c[1][k] - c[0][k]) + v * (c[2][k] - c[0][k]));
         }
     }
     let mut best = (f64::INFINITY, c[0]);
@@ -221,7 +220,7 @@ fn interpolate(p: [[f64; 2]; 3], c: [[f64; 4]; 3], x: [f64; 2]) -> [f64; 4] {
         let d2 = (x[0] - a[0] - t * dx).powi(2) + (x[1] - a[1] - t * dy).powi(2);
         if d2 < best.0 {
             let (ca, cb) = (c[k], c[(k + 1) % 3]);
-            best = (d2, [0, 1, 2, 3].map(|i| ca[i] + t * (cb[i] - ca[i])));
+            best = (d2, each4(|i| ca[i] + t * (cb[i] - ca[i])));
         }
     }
     best.1
@@ -302,8 +301,8 @@ fn sample_error(
     let Some(j) = jacobian else {
         return colour_error(space, sample, shown);
     };
-    let d = [0, 1, 2].map(|k| sample[k] - shown[k]);
-    let lab = j.map(|row| row[0] * d[0] + row[1] * d[1] + row[2] * d[2]);
+    let d = each3(|k| sample[k] - shown[k]);
+    let lab = each3(|r| j[r][0] * d[0] + j[r][1] * d[1] + j[r][2] * d[2]);
     let colour = (lab[0] * lab[0] + lab[1] * lab[1] + lab[2] * lab[2]).sqrt();
     colour.max(100.0 * (sample[3] - shown[3]).abs())
 }
@@ -326,8 +325,8 @@ pub(super) fn measure_quad(
     let attr = |d: &VertexData| [d[2], d[3], d[4], d[5]];
     let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
     let mut m = Measure::default();
-    let p = q.corners.map(px);
-    let c = q.corners.map(attr);
+    let p = each4(|k| px(q.corners[k]));
+    let c = each4(|k| attr(q.corners[k]));
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     let mut grow = |x: [f64; 2]| {
         for k in 0..2 {
@@ -357,7 +356,8 @@ pub(super) fn measure_quad(
         if !counts {
             return;
         }
-        let shown = interpolate(tris[tri].map(|i| p[i]), tris[tri].map(|i| c[i]), px(sample));
+        let t = tris[tri];
+        let shown = interpolate(each3(|i| p[t[i]]), each3(|i| c[t[i]]), px(sample));
         let jacobian = q.jacobians.map(|j| j[which]);
         m.colour = m
             .colour

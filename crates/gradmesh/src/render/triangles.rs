@@ -7,6 +7,8 @@
 //! perturbation of the sample point and so also settles centres on shared vertices). Interior
 //! edges have no gaps and no double coverage.
 
+use super::each4;
+
 /// Sub-pixel steps per pixel.
 pub(crate) const SUBPIXEL: i64 = 256;
 /// Snapped coordinates beyond this magnitude (2^32 pixels) are not rasterised.
@@ -393,10 +395,10 @@ impl Triangle {
         // near the image); farther, the rounding is a fraction of the gradient's change over
         // the triangle.
         let (dy, dx0) = ((y - o[1]) as f32, (x0 - o[0]) as f32);
-        let row: [f32; 4] = std::array::from_fn(|k| self.at_origin[k] + self.gy[k] * dy);
+        let row: [f32; 4] = each4(|k| self.at_origin[k] + self.gy[k] * dy);
         for (n, out) in out.iter_mut().enumerate() {
             let dx = dx0 + n as f32;
-            *out = std::array::from_fn(|k| row[k] + self.gx[k] * dx);
+            *out = each4(|k| row[k] + self.gx[k] * dx);
         }
         out
     }
