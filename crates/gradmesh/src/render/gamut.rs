@@ -112,7 +112,7 @@ pub(crate) fn to_blend_space(
 /// stay in `f32`, with the table of [`srgb_encode_f32`]; every other colour goes through
 /// [`to_blend_space`]. Single precision keeps about 7 digits, far below a 16-bit output step.
 /// The per-pixel loop converts whole runs with [`RunConverter`], which gives the same bits.
-#[inline]
+#[inline(always)]
 pub(crate) fn to_blend_space_f32(
     space: ColourSpace,
     c: [f32; 3],
@@ -120,9 +120,22 @@ pub(crate) fn to_blend_space_f32(
     blend: BlendSpace,
 ) -> [f32; 3] {
     let in_unit = |v: &[f32; 3]| v.iter().all(|x| (0.0..=1.0).contains(x));
+    // sRGB in range, blended in sRGB (as the `vs_cairo` scene): inline, nothing to do.
     if space == ColourSpace::Srgb && blend == BlendSpace::Srgb && in_unit(&c) {
         return c;
     }
+    to_blend_space_f32_converted(space, c, gamut, blend)
+}
+
+/// [`to_blend_space_f32`] when the colour needs converting.
+#[inline(never)]
+fn to_blend_space_f32_converted(
+    space: ColourSpace,
+    c: [f32; 3],
+    gamut: GamutMapping,
+    blend: BlendSpace,
+) -> [f32; 3] {
+    let in_unit = |v: &[f32; 3]| v.iter().all(|x| (0.0..=1.0).contains(x));
     if space == ColourSpace::Lab {
         let lin = lab_to_linear_srgb_f32(lab_matrix_f32(), c);
         if in_unit(&lin) {

@@ -681,23 +681,68 @@ fn draw_band<P: OutputPixel>(
                 &mut s.coverage[c0..c1],
             );
             let y = (y0 + r) as f64 + 0.5;
-            // In runs: first the pixels this layer shows, then their colours all at once
-            // (vectorised), then compositing.
-            let mut i = c0;
-            while i < c1 {
-                let run = &mut s.run;
-                let mut n = 0;
-                while i < c1 && n < RUN {
+            if layer.space == ColourSpace::Lab {
+                // In runs: first the pixels this layer shows, then their colours all at once
+                // (vectorised), then compositing.
+                let mut i = c0;
+                while i < c1 {
+                    let run = &mut s.run;
+                    let mut n = 0;
+                    while i < c1 && n < RUN {
+                        let cov = s.coverage[i];
+                        let k = r * w + i;
+                        i += 1;
+                        if cov == 0.0 || s.opaque[k] {
+                            continue;
+                        }
+                        let attr = if s.covered[k] {
+                            s.attributes[k]
+                        } else {
+                            match layer.nearest.attributes_at([(i - 1) as f64 + 0.5, y]) {
+                                Some(a) => a,
+                                None => continue,
+                            }
+                        };
+                        let alpha = cov * attr[3].clamp(0.0, 1.0);
+                        if alpha <= 0.0 {
+                            continue;
+                        }
+                        for c in 0..3 {
+                            run.colour[c][n] = attr[c];
+                        }
+                        run.alpha[n] = alpha;
+                        run.pixel[n] = k as u32;
+                        n += 1;
+                    }
+                    converter.convert(&run.colour, n, &mut run.rgb);
+                    for m in 0..n {
+                        let (k, alpha, rgb) = (run.pixel[m] as usize, run.alpha[m], run.rgb[m]);
+                        let dst = &mut colour[k];
+                        let weight = alpha * (1.0 - dst[3]);
+                        for c in 0..3 {
+                            dst[c] += rgb[c] * weight;
+                        }
+                        // a + (1 - a) is 1, but not always in floating point.
+                        dst[3] = if alpha >= 1.0 { 1.0 } else { dst[3] + weight };
+                        if dst[3] >= 1.0 {
+                            s.opaque[k] = true;
+                            opaque += 1;
+                        }
+                    }
+                }
+            } else {
+                // Pixel by pixel: the other spaces have no vector path, and gathering them
+                // into runs cost the sRGB `vs_cairo` scene 4 % more instructions.
+                for i in c0..c1 {
                     let cov = s.coverage[i];
                     let k = r * w + i;
-                    i += 1;
                     if cov == 0.0 || s.opaque[k] {
                         continue;
                     }
                     let attr = if s.covered[k] {
                         s.attributes[k]
                     } else {
-                        match layer.nearest.attributes_at([(i - 1) as f64 + 0.5, y]) {
+                        match layer.nearest.attributes_at([i as f64 + 0.5, y]) {
                             Some(a) => a,
                             None => continue,
                         }
@@ -706,16 +751,12 @@ fn draw_band<P: OutputPixel>(
                     if alpha <= 0.0 {
                         continue;
                     }
-                    for c in 0..3 {
-                        run.colour[c][n] = attr[c];
-                    }
-                    run.alpha[n] = alpha;
-                    run.pixel[n] = k as u32;
-                    n += 1;
-                }
-                converter.convert(&run.colour, n, &mut run.rgb);
-                for m in 0..n {
-                    let (k, alpha, rgb) = (run.pixel[m] as usize, run.alpha[m], run.rgb[m]);
+                    let rgb = gamut::to_blend_space_f32(
+                        layer.space,
+                        [attr[0], attr[1], attr[2]],
+                        opts.gamut,
+                        opts.blend,
+                    );
                     let dst = &mut colour[k];
                     let weight = alpha * (1.0 - dst[3]);
                     for c in 0..3 {
