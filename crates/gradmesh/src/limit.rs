@@ -33,13 +33,24 @@ pub fn limit_stencils(level: &Level) -> Option<Stencils> {
     Some(Stencils::concat(&parts))
 }
 
-/// The limit stencils of vertices `range` of `level` (see [`limit_stencils`]).
-fn limit_stencils_of(level: &Level, range: std::ops::Range<usize>) -> Option<Stencils> {
+/// The limit stencils of the given vertices of `level`, in their order (see
+/// [`limit_stencils`]; `None` if a face next to one of them that needs it is not a quad).
+/// For a few vertices of a level: a locally refined face needs only its own grid's points.
+pub fn limit_stencils_for(level: &Level, vertices: &[u32]) -> Option<Stencils> {
+    limit_stencils_of(level, vertices.iter().map(|&v| v as usize))
+}
+
+/// The limit stencils of `vertices` of `level` (see [`limit_stencils`]).
+fn limit_stencils_of(
+    level: &Level,
+    vertices: impl ExactSizeIterator<Item = usize>,
+) -> Option<Stencils> {
     let t = &level.topology;
-    let mut stencils = Stencils::with_capacity(range.len(), 10 * range.len());
+    let count = vertices.len();
+    let mut stencils = Stencils::with_capacity(count, 10 * count);
     let mut terms = Vec::with_capacity(32);
     let mut dart_masks: HashMap<usize, Vec<f64>> = HashMap::new();
-    for v in range {
+    for v in vertices {
         let edges = t.vertex_edges(v);
         match level.vertex_rule(v) {
             VertexRule::Corner => terms.push((v as u32, 1.0)),
@@ -222,6 +233,52 @@ mod tests {
                 gap = (d[index][0] - mask[0]).hypot(d[index][1] - mask[1]);
             }
             assert!(gap < 0.2 * first_gap, "n {n}: {gap} after {first_gap}");
+        }
+    }
+
+    /// The stencils of a few vertices, in any order, are those of the whole level, bit for bit
+    /// (smooth, boundary and corner vertices of a grid with a dart in it).
+    #[test]
+    fn stencils_of_some_vertices_match_the_whole_level() {
+        let n = 4u32;
+        let mut faces = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let v = j * (n + 1) + i;
+                faces.push(vec![v, v + 1, v + n + 2, v + n + 1]);
+            }
+        }
+        let topology = Topology::from_faces(25, &faces).unwrap();
+        let edge_sharpness = (0..topology.edge_count())
+            .map(|e| {
+                let [a, b] = topology.edge_vertices(e);
+                // Boundary, and one spoke from the centre: the centre is a dart.
+                if topology.is_boundary_edge(e) || (a.min(b), a.max(b)) == (7, 12) {
+                    SHARPNESS_INFINITE
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let level = Level {
+            topology,
+            edge_sharpness,
+            vertex_sharpness: vec![0.0; 25],
+            creasing: CreasingMethod::Uniform,
+        };
+        assert_eq!(level.vertex_rule(12), VertexRule::Dart);
+        let all = limit_stencils(&level).unwrap();
+        let some = [12u32, 0, 7, 24, 6, 2];
+        let part = limit_stencils_for(&level, &some).unwrap();
+        for (k, &v) in some.iter().enumerate() {
+            let (s, w) = all.stencil(v as usize);
+            let (ps, pw) = part.stencil(k);
+            assert_eq!(s, ps, "vertex {v}");
+            assert_eq!(
+                w.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                pw.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                "vertex {v}"
+            );
         }
     }
 

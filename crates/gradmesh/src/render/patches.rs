@@ -462,10 +462,22 @@ impl LocalPatch {
             self.deepen()?;
         }
         let at = &self.levels[depth];
-        let limits = limit::limit_stencils(&at.level)?.apply(&at.data);
+        let t = &at.level.topology;
+        // The limit points of the tiles' corners only (the ring around them is most of the
+        // local level), each once.
+        let mut slot = vec![u32::MAX; t.vertex_count()];
+        let mut wanted = Vec::with_capacity((n + 1) * (n + 1));
+        for tile in &at.tiles {
+            for &v in t.face_vertices(tile.face as usize) {
+                if slot[v as usize] == u32::MAX {
+                    slot[v as usize] = wanted.len() as u32;
+                    wanted.push(v);
+                }
+            }
+        }
+        let limits = limit::limit_stencils_for(&at.level, &wanted)?.apply(&at.data);
         let stride = n as i64 + 1;
         let mut grid = vec![[0.0; 6]; (n + 1) * (n + 1)];
-        let t = &at.level.topology;
         for tile in &at.tiles {
             let o = tile.origin;
             let corners = [
@@ -476,7 +488,7 @@ impl LocalPatch {
             ];
             for (k, &v) in t.face_vertices(tile.face as usize).iter().enumerate() {
                 let p = corners[k];
-                grid[(p[1] * stride + p[0]) as usize] = limits[v as usize];
+                grid[(p[1] * stride + p[0]) as usize] = limits[slot[v as usize] as usize];
             }
         }
         Some(grid)
