@@ -290,32 +290,30 @@ pub(crate) struct LocalPatch {
 fn extract(level: &Level, data: &[VertexData], keep: &[u32]) -> Option<(Level, Vec<VertexData>)> {
     let t = &level.topology;
     let mut vertices: Vec<u32> = Vec::new();
-    let faces: Vec<Vec<u32>> = VERTEX_MAP.with(|cell| {
+    // Flat, as the topology keeps them: a list per face cost an allocation per face.
+    let mut offsets = Vec::with_capacity(keep.len() + 1);
+    let mut corners = Vec::with_capacity(4 * keep.len());
+    offsets.push(0u32);
+    VERTEX_MAP.with(|cell| {
         let mut vertex_map = cell.borrow_mut();
         if vertex_map.len() < t.vertex_count() {
             vertex_map.resize(t.vertex_count(), u32::MAX);
         }
-        let faces = keep
-            .iter()
-            .map(|&g| {
-                t.face_vertices(g as usize)
-                    .iter()
-                    .map(|&v| {
-                        if vertex_map[v as usize] == u32::MAX {
-                            vertex_map[v as usize] = vertices.len() as u32;
-                            vertices.push(v);
-                        }
-                        vertex_map[v as usize]
-                    })
-                    .collect()
-            })
-            .collect();
+        for &g in keep {
+            for &v in t.face_vertices(g as usize) {
+                if vertex_map[v as usize] == u32::MAX {
+                    vertex_map[v as usize] = vertices.len() as u32;
+                    vertices.push(v);
+                }
+                corners.push(vertex_map[v as usize]);
+            }
+            offsets.push(corners.len() as u32);
+        }
         for &v in &vertices {
             vertex_map[v as usize] = u32::MAX;
         }
-        faces
     });
-    let topology = Topology::from_faces(vertices.len(), &faces).ok()?;
+    let topology = Topology::build(vertices.len(), offsets, corners, |_, _| false).ok()?;
     let edge_sharpness = (0..topology.edge_count())
         .map(|e| {
             let [a, b] = topology.edge_vertices(e);
