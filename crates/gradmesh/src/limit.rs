@@ -236,10 +236,9 @@ mod tests {
         }
     }
 
-    /// The stencils of a few vertices, in any order, are those of the whole level, bit for bit
-    /// (smooth, boundary and corner vertices of a grid with a dart in it).
-    #[test]
-    fn stencils_of_some_vertices_match_the_whole_level() {
+    /// A 4x4 grid of quads (vertex `5 j + i`), its boundary and the edges `(a, b)` for which
+    /// `sharp(a, b)` holds infinitely sharp.
+    fn grid_4x4(sharp: impl Fn(u32, u32) -> bool) -> Level {
         let n = 4u32;
         let mut faces = Vec::new();
         for j in 0..n {
@@ -252,20 +251,27 @@ mod tests {
         let edge_sharpness = (0..topology.edge_count())
             .map(|e| {
                 let [a, b] = topology.edge_vertices(e);
-                // Boundary, and one spoke from the centre: the centre is a dart.
-                if topology.is_boundary_edge(e) || (a.min(b), a.max(b)) == (7, 12) {
+                if topology.is_boundary_edge(e) || sharp(a, b) {
                     SHARPNESS_INFINITE
                 } else {
                     0.0
                 }
             })
             .collect();
-        let level = Level {
+        Level {
             topology,
             edge_sharpness,
             vertex_sharpness: vec![0.0; 25],
             creasing: CreasingMethod::Uniform,
-        };
+        }
+    }
+
+    /// The stencils of a few vertices, in any order, are those of the whole level, bit for bit
+    /// (smooth, boundary and corner vertices of a grid with a dart in it).
+    #[test]
+    fn stencils_of_some_vertices_match_the_whole_level() {
+        // Boundary, and one spoke from the centre: the centre is a dart.
+        let level = grid_4x4(|a, b| (a.min(b), a.max(b)) == (7, 12));
         assert_eq!(level.vertex_rule(12), VertexRule::Dart);
         let all = limit_stencils(&level).unwrap();
         let some = [12u32, 0, 7, 24, 6, 2];
@@ -285,30 +291,7 @@ mod tests {
     #[test]
     fn regular_interior_limit_is_the_bspline_point() {
         // (1/36) [1 4 1; 4 16 4; 1 4 1] on a regular grid.
-        let n = 4u32;
-        let mut faces = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                let v = j * (n + 1) + i;
-                faces.push(vec![v, v + 1, v + n + 2, v + n + 1]);
-            }
-        }
-        let topology = Topology::from_faces(25, &faces).unwrap();
-        let edge_sharpness = (0..topology.edge_count())
-            .map(|e| {
-                if topology.is_boundary_edge(e) {
-                    SHARPNESS_INFINITE
-                } else {
-                    0.0
-                }
-            })
-            .collect();
-        let level = Level {
-            topology,
-            edge_sharpness,
-            vertex_sharpness: vec![0.0; 25],
-            creasing: CreasingMethod::Uniform,
-        };
+        let level = grid_4x4(|_, _| false);
         let st = limit_stencils(&level).unwrap();
         let (s, w) = st.stencil(12);
         for (&s, &w) in s.iter().zip(w) {

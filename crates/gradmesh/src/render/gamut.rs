@@ -111,7 +111,8 @@ pub(crate) fn to_blend_space(
 /// [`to_blend_space`] in single precision: Lab and sRGB colours inside the gamut (most pixels)
 /// stay in `f32`, with the table of [`srgb_encode_f32`]; every other colour goes through
 /// [`to_blend_space`]. Single precision keeps about 7 digits, far below a 16-bit output step.
-/// The per-pixel loop converts whole runs with [`RunConverter`], which gives the same bits.
+/// The per-pixel loop converts Lab colours in runs with [`RunConverter`], which gives the
+/// same bits.
 #[inline(always)]
 pub(crate) fn to_blend_space_f32(
     space: ColourSpace,
@@ -119,7 +120,6 @@ pub(crate) fn to_blend_space_f32(
     gamut: GamutMapping,
     blend: BlendSpace,
 ) -> [f32; 3] {
-    let in_unit = |v: &[f32; 3]| v.iter().all(|x| (0.0..=1.0).contains(x));
     // sRGB in range, blended in sRGB (as the `vs_cairo` scene): inline, nothing to do.
     if space == ColourSpace::Srgb && blend == BlendSpace::Srgb && in_unit(&c) {
         return c;
@@ -135,21 +135,31 @@ fn to_blend_space_f32_converted(
     gamut: GamutMapping,
     blend: BlendSpace,
 ) -> [f32; 3] {
-    let in_unit = |v: &[f32; 3]| v.iter().all(|x| (0.0..=1.0).contains(x));
     if space == ColourSpace::Lab {
         let lin = lab_to_linear_srgb_f32(lab_matrix_f32(), c);
         if in_unit(&lin) {
-            return match blend {
-                BlendSpace::Linear => lin,
-                BlendSpace::Srgb => [
-                    srgb_encode_f32(lin[0]),
-                    srgb_encode_f32(lin[1]),
-                    srgb_encode_f32(lin[2]),
-                ],
-            };
+            return linear_to_blend_space_f32(encode_table_f32(), lin, blend);
         }
     }
     to_blend_space_wide(space, c, gamut, blend)
+}
+
+/// Whether every channel lies in `0..=1`.
+#[inline(always)]
+fn in_unit(v: &[f32; 3]) -> bool {
+    v.iter().all(|x| (0.0..=1.0).contains(x))
+}
+
+/// An in-gamut linear-light colour in the blend space, with the encoding `table`
+/// ([`encode_table_f32`]).
+#[inline(always)]
+fn linear_to_blend_space_f32(table: &[f32], lin: [f32; 3], blend: BlendSpace) -> [f32; 3] {
+    // Written out: `array::map` with a closure stayed a chain of calls here.
+    let encode = |v| srgb_encode_f32_with(table, v);
+    match blend {
+        BlendSpace::Linear => lin,
+        BlendSpace::Srgb => [encode(lin[0]), encode(lin[1]), encode(lin[2])],
+    }
 }
 
 /// [`to_blend_space`] of a single-precision colour.
@@ -194,7 +204,6 @@ impl RunConverter {
     #[inline]
     pub fn convert(&self, c: &[[f32; RUN]; 3], n: usize, out: &mut [[f32; 3]; RUN]) {
         let n = n.min(RUN);
-        let in_unit = |v: &[f32; 3]| v.iter().all(|x| (0.0..=1.0).contains(x));
         if self.space != ColourSpace::Lab {
             for m in 0..n {
                 let colour = [c[0][m], c[1][m], c[2][m]];
@@ -212,20 +221,11 @@ impl RunConverter {
         }
         for m in 0..n {
             let l = [lin[0][m], lin[1][m], lin[2][m]];
-            out[m] = if !in_unit(&l) {
-                to_blend_space_wide(
-                    self.space,
-                    [c[0][m], c[1][m], c[2][m]],
-                    self.gamut,
-                    self.blend,
-                )
+            out[m] = if in_unit(&l) {
+                linear_to_blend_space_f32(self.table, l, self.blend)
             } else {
-                // Written out: `array::map` with a closure stayed a chain of calls here.
-                let encode = |v| srgb_encode_f32_with(self.table, v);
-                match self.blend {
-                    BlendSpace::Linear => l,
-                    BlendSpace::Srgb => [encode(l[0]), encode(l[1]), encode(l[2])],
-                }
+                let colour = [c[0][m], c[1][m], c[2][m]];
+                to_blend_space_wide(self.space, colour, self.gamut, self.blend)
             };
         }
     }
