@@ -111,8 +111,14 @@ impl ColourSpace {
             ColourSpace::Oklab => Self::oklab_to_lab_jacobian(c),
             ColourSpace::SrgbLinear => linear_srgb_to_lab_jacobian(c),
             ColourSpace::Srgb => {
-                let lin = c.map(|v| tables().decode.at(v).unwrap_or_else(|| srgb_decode(v)));
-                let slope = c.map(srgb_decode_slope);
+                // Loops, not `array::map`: with closures these stayed chains of calls, and the
+                // renderer asks for a Jacobian per sample.
+                let decode = &tables().decode;
+                let (mut lin, mut slope) = ([0.0; 3], [0.0; 3]);
+                for k in 0..3 {
+                    lin[k] = decode.at(c[k]).unwrap_or_else(|| srgb_decode(c[k]));
+                    slope[k] = srgb_decode_slope(c[k]);
+                }
                 let mut j = linear_srgb_to_lab_jacobian(lin);
                 for row in &mut j {
                     for k in 0..3 {
@@ -185,7 +191,8 @@ impl Table {
         if !(0.0..Self::SAMPLES as f64).contains(&u) {
             return None;
         }
-        let k = u as usize;
+        // Through `i32`: a float to `usize` conversion takes a dozen instructions on x86-64.
+        let k = u as i32 as usize;
         let t = u - k as f64;
         Some(self.values[k] + t * (self.values[k + 1] - self.values[k]))
     }
@@ -247,17 +254,17 @@ fn linear_srgb_to_lab_jacobian(rgb: [f64; 3]) -> Matrix3 {
         }
         n
     });
-    let t: [f64; 3] = [0, 1, 2].map(|i| n[i][0] * rgb[0] + n[i][1] * rgb[1] + n[i][2] * rgb[2]);
-    let slope = t.map(|t| {
-        if t > DELTA * DELTA * DELTA {
-            tables()
-                .lab_slope
-                .at(t)
-                .unwrap_or_else(|| lab_slope_exact(t))
+    // Loops rather than `array::map` (see `lab_jacobian`).
+    let lab_slope = &tables().lab_slope;
+    let mut slope = [0.0; 3];
+    for i in 0..3 {
+        let t = n[i][0] * rgb[0] + n[i][1] * rgb[1] + n[i][2] * rgb[2];
+        slope[i] = if t > DELTA * DELTA * DELTA {
+            lab_slope.at(t).unwrap_or_else(|| lab_slope_exact(t))
         } else {
             1.0 / (3.0 * DELTA * DELTA)
-        }
-    });
+        };
+    }
     // Rows of A: L = 116 fy - 16, a = 500 (fx - fy), b = 200 (fy - fz).
     let a = [
         [0.0, 116.0, 0.0],
@@ -267,7 +274,9 @@ fn linear_srgb_to_lab_jacobian(rgb: [f64; 3]) -> Matrix3 {
     let mut j = [[0.0; 3]; 3];
     for i in 0..3 {
         for k in 0..3 {
-            j[i][k] = (0..3).map(|m| a[i][m] * slope[m] * n[m][k]).sum();
+            j[i][k] = a[i][0] * slope[0] * n[0][k]
+                + a[i][1] * slope[1] * n[1][k]
+                + a[i][2] * slope[2] * n[2][k];
         }
     }
     j

@@ -1,5 +1,10 @@
 //! The meshes the benchmarks share.
 
+// Each bench uses part of this.
+#![allow(dead_code)]
+
+pub mod wavy_grid;
+
 use gradmesh::{ColourSpace, GradientMesh};
 use kurbo::Point;
 
