@@ -64,6 +64,13 @@ pub(crate) fn evaluate_patch_at(cp: &ControlGrid, u: f64, v: f64) -> VertexData 
 
 /// The patch of `cp` on a grid of `n x n` cells.
 pub(crate) fn evaluate_patch(cp: &ControlGrid, n: usize) -> Grid {
+    let mut out = Vec::with_capacity((n + 1) * (n + 1));
+    evaluate_patch_with(cp, n, |_, _, p| out.push(p));
+    out
+}
+
+/// Calls `put(i, j, p)` with the patch of `cp` at parameter `(i / n, j / n)`, row by row.
+fn evaluate_patch_with(cp: &ControlGrid, n: usize, mut put: impl FnMut(usize, usize, VertexData)) {
     // Most faces stop at a few cells: their basis values stay on the stack.
     let (mut small, mut large) = ([[0.0; 4]; 17], Vec::new());
     let basis: &mut [[f64; 4]] = if n < small.len() {
@@ -75,8 +82,7 @@ pub(crate) fn evaluate_patch(cp: &ControlGrid, n: usize) -> Grid {
     for (i, b) in basis.iter_mut().enumerate() {
         *b = bspline_basis(i as f64 / n as f64);
     }
-    let mut out = Vec::with_capacity((n + 1) * (n + 1));
-    for bv in basis.iter() {
+    for (j, bv) in basis.iter().enumerate() {
         // The four columns collapsed to this row's curve first: 16 then 4 terms per sample.
         let mut q = [[0.0; 6]; 4];
         for (i, qi) in q.iter_mut().enumerate() {
@@ -86,17 +92,16 @@ pub(crate) fn evaluate_patch(cp: &ControlGrid, n: usize) -> Grid {
                 }
             }
         }
-        for bu in basis.iter() {
+        for (i, bu) in basis.iter().enumerate() {
             let mut p = [0.0; 6];
             for (i, qi) in q.iter().enumerate() {
                 for k in 0..6 {
                     p[k] += bu[i] * qi[k];
                 }
             }
-            out.push(p);
+            put(i, j, p);
         }
     }
-    out
 }
 
 /// Whether vertex `v` keeps the regular B-spline rules at every later level: interior of
@@ -270,15 +275,22 @@ struct Tile {
     v: [i64; 2],
 }
 
-/// One depth of a locally refined face: the faces around its descendants, as their own mesh.
+/// One depth of a locally refined face.
 struct LocalLevel {
-    level: Level,
-    data: Vec<VertexData>,
+    /// The faces around `tiles`, as their own mesh (`None` when no tile is left).
+    local: Option<(Level, Vec<VertexData>)>,
+    /// The face's descendants at this depth that are refined further.
     tiles: Vec<Tile>,
+    /// Its descendants at this depth whose limit surface is a B-spline patch: evaluated
+    /// directly, never refined.
+    patches: Vec<(Tile, ControlGrid)>,
 }
 
-/// A face refined on its own: at each depth only the faces around its descendants (which
-/// determine their limit surface) are kept, so the cost grows with the face's own samples.
+/// A face refined on its own, feature-adaptively: at each depth the descendants that have
+/// become regular patches are set aside, and only the faces around the others (which
+/// determine their limit surface) are refined further. Next to an extraordinary vertex one
+/// descendant a depth stays irregular, along a crease a row of them, so the work per depth
+/// stays nearly constant instead of growing fourfold.
 pub(crate) struct LocalPatch {
     levels: Vec<LocalLevel>,
 }
@@ -399,9 +411,9 @@ impl LocalPatch {
         }];
         Some(LocalPatch {
             levels: vec![LocalLevel {
-                level: local,
-                data: local_data,
+                local: Some((local, local_data)),
                 tiles,
+                patches: Vec::new(),
             }],
         })
     }
@@ -409,14 +421,22 @@ impl LocalPatch {
     /// The data of the neighbourhood's points: the face's limit surface lies in their convex
     /// hull.
     pub fn control_points(&self) -> &[VertexData] {
-        &self.levels[0].data
+        &self.levels[0]
+            .local
+            .as_ref()
+            .expect("depth 0 has the face")
+            .1
     }
 
-    /// Refines the last depth once and keeps the faces around the new tiles.
+    /// Refines the last depth once: children that are regular patches are set aside, and the
+    /// faces around the others kept.
     fn deepen(&mut self) -> Option<()> {
         let last = self.levels.last().expect("depth 0");
-        let (child, stencils) = catmull_clark::refine(&last.level);
-        let child_data = stencils.apply(&last.data);
+        let Some((last_level, last_data)) = &last.local else {
+            return Some(());
+        };
+        let (child, stencils) = catmull_clark::refine(last_level);
+        let child_data = stencils.apply(last_data);
         let mut tiles = Vec::with_capacity(4 * last.tiles.len());
         for tile in &last.tiles {
             // Corners in the grid of the next depth (twice as fine).
@@ -430,7 +450,7 @@ impl LocalPatch {
                 ],
                 [o[0] + 2 * tile.v[0], o[1] + 2 * tile.v[1]],
             ];
-            let first = last.level.topology.face_offset(tile.face as usize);
+            let first = last_level.topology.face_offset(tile.face as usize);
             // Child c sits at corner c, its first side along side c, its last along side c - 1.
             for c in 0..4 {
                 let p = corners[c];
@@ -443,29 +463,72 @@ impl LocalPatch {
                 });
             }
         }
-        let keep = neighbourhood(&child.topology, &tiles);
-        let (level, data) = extract(&child, &child_data, &keep)?;
-        for tile in &mut tiles {
-            tile.face = local_face(&keep, tile.face);
-        }
-        self.levels.push(LocalLevel { level, data, tiles });
+        let mut patches = Vec::new();
+        tiles.retain(|tile| {
+            let face = tile.face as usize;
+            match regular_patch_with(&child, &child_data, face, |v| regular_corner(&child, v)) {
+                Some(cp) => {
+                    patches.push((*tile, cp));
+                    false
+                }
+                None => true,
+            }
+        });
+        let local = if tiles.is_empty() {
+            None
+        } else {
+            let keep = neighbourhood(&child.topology, &tiles);
+            let local = extract(&child, &child_data, &keep)?;
+            for tile in &mut tiles {
+                tile.face = local_face(&keep, tile.face);
+            }
+            Some(local)
+        };
+        self.levels.push(LocalLevel {
+            local,
+            tiles,
+            patches,
+        });
         Some(())
     }
 
-    /// The limit surface over the face on a grid of `n x n` cells (`n` a power of two): its
-    /// descendants `log2 n` levels down, at their limit positions.
+    /// The limit surface over the face on a grid of `n x n` cells (`n` a power of two): the
+    /// patches set aside down to depth `log2 n` on their share of the grid, and the corners of
+    /// the descendants still refined at that depth at their limit positions.
     pub fn grid(&mut self, n: usize) -> Option<Grid> {
         let depth = n.trailing_zeros() as usize;
-        while self.levels.len() <= depth {
+        while self.levels.len() <= depth && !self.levels.last().expect("depth 0").tiles.is_empty() {
             self.deepen()?;
         }
-        let at = &self.levels[depth];
-        let t = &at.level.topology;
+        let stride = n as i64 + 1;
+        let mut grid = vec![[0.0; 6]; (n + 1) * (n + 1)];
+        for (d, at) in self.levels.iter().enumerate().take(depth + 1) {
+            // A tile of depth `d` spans `m` cells of the grid.
+            let m = 1i64 << (depth - d);
+            for (tile, cp) in &at.patches {
+                let o = [tile.origin[0] * m, tile.origin[1] * m];
+                evaluate_patch_with(cp, m as usize, |i, j, p| {
+                    let (i, j) = (i as i64, j as i64);
+                    let x = o[0] + i * tile.u[0] + j * tile.v[0];
+                    let y = o[1] + i * tile.u[1] + j * tile.v[1];
+                    grid[(y * stride + x) as usize] = p;
+                });
+            }
+        }
+        let Some(LocalLevel {
+            local: Some((level, data)),
+            tiles,
+            ..
+        }) = self.levels.get(depth)
+        else {
+            return Some(grid);
+        };
+        let t = &level.topology;
         // The limit points of the tiles' corners only (the ring around them is most of the
         // local level), each once.
         let mut slot = vec![u32::MAX; t.vertex_count()];
-        let mut wanted = Vec::with_capacity((n + 1) * (n + 1));
-        for tile in &at.tiles {
+        let mut wanted = Vec::with_capacity(4 * tiles.len());
+        for tile in tiles {
             for &v in t.face_vertices(tile.face as usize) {
                 if slot[v as usize] == u32::MAX {
                     slot[v as usize] = wanted.len() as u32;
@@ -473,10 +536,8 @@ impl LocalPatch {
                 }
             }
         }
-        let limits = limit::limit_stencils_for(&at.level, &wanted)?.apply(&at.data);
-        let stride = n as i64 + 1;
-        let mut grid = vec![[0.0; 6]; (n + 1) * (n + 1)];
-        for tile in &at.tiles {
+        let limits = limit::limit_stencils_for(level, &wanted)?.apply(data);
+        for tile in tiles {
             let o = tile.origin;
             let corners = [
                 o,
@@ -624,6 +685,133 @@ mod tests {
         for (p, q) in a.iter().zip(&b) {
             assert!(close(*p, *q), "{p:?} vs {q:?}");
         }
+    }
+
+    /// Face `f`'s grid of `n` cells from refining the whole of `level` `log2 n` times: the
+    /// oracle for [`LocalPatch::grid`].
+    fn whole_mesh_grid(level: &Level, data: &[VertexData], f: usize, n: usize) -> Grid {
+        let (mut level, mut data) = (level.clone(), data.to_vec());
+        let mut tiles = vec![Tile {
+            face: f as u32,
+            origin: [0, 0],
+            u: [1, 0],
+            v: [0, 1],
+        }];
+        for _ in 0..n.trailing_zeros() {
+            let mut children = Vec::new();
+            for tile in &tiles {
+                let first = level.topology.face_offset(tile.face as usize);
+                let o = [2 * tile.origin[0], 2 * tile.origin[1]];
+                let (u, v) = (tile.u, tile.v);
+                let corners = [
+                    o,
+                    [o[0] + 2 * u[0], o[1] + 2 * u[1]],
+                    [o[0] + 2 * (u[0] + v[0]), o[1] + 2 * (u[1] + v[1])],
+                    [o[0] + 2 * v[0], o[1] + 2 * v[1]],
+                ];
+                for c in 0..4 {
+                    let p = corners[c];
+                    let towards = |q: [i64; 2]| [(q[0] - p[0]) / 2, (q[1] - p[1]) / 2];
+                    children.push(Tile {
+                        face: (first + c) as u32,
+                        origin: p,
+                        u: towards(corners[(c + 1) % 4]),
+                        v: towards(corners[(c + 3) % 4]),
+                    });
+                }
+            }
+            let (child, stencils) = refine(&level);
+            data = stencils.apply(&data);
+            level = child;
+            tiles = children;
+        }
+        let lim = limit::limit_stencils(&level).unwrap().apply(&data);
+        let stride = n as i64 + 1;
+        let mut grid = vec![[f64::NAN; 6]; (n + 1) * (n + 1)];
+        for tile in &tiles {
+            let fv = level.topology.face_vertices(tile.face as usize);
+            let o = tile.origin;
+            let (u, v) = (tile.u, tile.v);
+            let corners = [
+                o,
+                [o[0] + u[0], o[1] + u[1]],
+                [o[0] + u[0] + v[0], o[1] + u[1] + v[1]],
+                [o[0] + v[0], o[1] + v[1]],
+            ];
+            for k in 0..4 {
+                let p = corners[k];
+                grid[(p[1] * stride + p[0]) as usize] = lim[fv[k] as usize];
+            }
+        }
+        grid
+    }
+
+    /// Checks face `f`'s local grids of 1 to 16 cells against the whole mesh's, and returns
+    /// how many patches its local refinement set aside.
+    fn check_local_grids(level: &Level, data: &[VertexData], f: usize) -> usize {
+        let mut local = LocalPatch::new(level, data, f).unwrap();
+        for n in [1, 2, 4, 8, 16, 4] {
+            let expected = whole_mesh_grid(level, data, f, n);
+            let got = local.grid(n).unwrap();
+            for (k, (a, b)) in got.iter().zip(&expected).enumerate() {
+                assert!(
+                    close(*a, *b),
+                    "face {f}, n = {n}, sample {k}: {a:?} vs {b:?}"
+                );
+            }
+        }
+        local.levels.iter().map(|l| l.patches.len()).sum()
+    }
+
+    #[test]
+    fn local_refinement_sets_regular_descendants_aside_without_changing_the_surface() {
+        // Around a valence-5 vertex.
+        let (level, data) = star_level();
+        let t = &level.topology;
+        let centre = (0..t.vertex_count())
+            .find(|&v| t.vertex_edges(v).len() == 5)
+            .unwrap() as u32;
+        let around: Vec<usize> = (0..t.face_count())
+            .filter(|&f| t.face_vertices(f).contains(&centre))
+            .collect();
+        assert_eq!(around.len(), 5);
+        for &f in &around {
+            let set_aside = check_local_grids(&level, &data, f);
+            // Three children a depth become regular: 3 at each of the four depths.
+            assert_eq!(set_aside, 12, "face {f}");
+        }
+        // Along a semi-sharp crease (sharpness 2.5, decaying over three levels) and an
+        // infinitely sharp one, up to the boundary, with a semi-sharp vertex.
+        let (mut level, data) = grid_level(6);
+        let t = level.topology.clone();
+        let vertex = |i: u32, j: u32| j * 7 + i;
+        let edge = |a: u32, b: u32| {
+            (0..t.edge_count())
+                .find(|&e| {
+                    let [p, q] = t.edge_vertices(e);
+                    (p, q) == (a, b) || (p, q) == (b, a)
+                })
+                .unwrap()
+        };
+        for i in 0..6 {
+            level.edge_sharpness[edge(vertex(i, 3), vertex(i + 1, 3))] = 2.5;
+            level.edge_sharpness[edge(vertex(3, i), vertex(3, i + 1))] = f64::INFINITY;
+        }
+        level.vertex_sharpness[vertex(2, 2) as usize] = 1.5;
+        let level = Level::new(
+            level.topology,
+            level.edge_sharpness,
+            level.vertex_sharpness,
+            CreasingMethod::Uniform,
+            BoundaryInterpolation::EdgeAndCorner,
+        );
+        let mut set_aside = 0;
+        for f in 0..t.face_count() {
+            if regular_patch(&level, &data, f).is_none() {
+                set_aside += check_local_grids(&level, &data, f);
+            }
+        }
+        assert!(set_aside > 0);
     }
 
     /// Level 2 of a five-quad star subdivided twice: a valence-5 vertex (0) in an all-quad mesh
