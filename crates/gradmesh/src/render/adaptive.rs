@@ -356,6 +356,7 @@ pub(super) fn tessellate(
             return Some(plan);
         }
         let boundary = boundary_sides(f);
+        let mut last_colour: Option<f64> = None;
         loop {
             if plan.n >= n_max {
                 plan.capped = true;
@@ -381,10 +382,18 @@ pub(super) fn tessellate(
                 }
                 return Some(plan);
             }
-            // Colour and size halve at least per level; the outline's distance quarters.
+            // Size halves per level and the outline's distance quarters. The colour error of
+            // linear pieces quarters where the colour is smooth, but may only halve next to an
+            // extraordinary vertex or a fold: predict the rate it fell at over the last level,
+            // between the two (a half when there is no last level).
+            let ratio = match last_colour {
+                Some(prev) if prev > 0.0 => (m.colour / prev).clamp(0.25, 0.5),
+                _ => 0.5,
+            };
+            last_colour = Some(m.colour);
             let predicted = Measure {
                 extent: 0.5 * m.extent,
-                colour: 0.5 * m.colour,
+                colour: ratio * m.colour,
                 outline: 0.25 * m.outline,
             };
             plan.n *= 2;

@@ -299,8 +299,10 @@ pub struct LayerInfo {
     /// unit), between the colour the triangles show at the centre of a quad or edge and the
     /// limit colour there (NaN when not measured).
     pub max_colour_error: f64,
-    /// Whether the three figures above are estimated from the level above (halving per level,
-    /// the outline's distance quartering) rather than measured at the level drawn.
+    /// Whether the three figures above are estimated from the level above (size halving per
+    /// level, the outline's distance quartering, the colour error falling at the rate it fell
+    /// over the level before, between a quarter and a half) rather than measured at the level
+    /// drawn.
     pub estimated: bool,
     /// Time spent on each stage of preparing this layer (zero when [`LayerInfo::reused`]).
     pub timings: LayerTimings,
