@@ -29,47 +29,125 @@ impl Line {
     }
 }
 
-/// Adds the contribution of `line` to the accumulation rows `row0 .. row0 + rows` of width
-/// `width` (each accumulation row holds `width + 2` cells).
-pub(crate) fn accumulate(acc: &mut [f64], width: usize, row0: i64, rows: usize, line: &Line) {
-    let ([x0, y0], [x1, y1], dir) = if line.p0[1] < line.p1[1] {
-        (line.p0, line.p1, 1.0)
-    } else if line.p0[1] > line.p1[1] {
-        (line.p1, line.p0, -1.0)
-    } else {
-        return;
-    };
-    let stride = width + 2;
-    let dxdy = (x1 - x0) / (y1 - y0);
-    let first = (y0.floor() as i64).max(row0);
-    let last = (y1.ceil() as i64).min(row0 + rows as i64);
-    for j in first..last {
-        let ya = y0.max(j as f64);
-        let yb = y1.min((j + 1) as f64);
-        if yb <= ya {
-            continue;
+/// Accumulation rows of a band, each with the runs of cells its segments touched.
+///
+/// A layer's outline crosses a row in a few places and touches a few cells there; only those
+/// are summed and cleared again, and between them the coverage is constant. Every row is left
+/// cleared by [`Accumulator::resolve`], so one accumulator serves band after band.
+#[derive(Clone, Debug)]
+pub(crate) struct Accumulator {
+    width: usize,
+    /// `width + 2` cells a row: a segment's contribution may spill one cell past the image.
+    cells: Vec<f64>,
+    /// Runs of cells `[first, end)` of each row that may be non-zero, in the order added.
+    touched: Vec<Vec<[usize; 2]>>,
+}
+
+impl Accumulator {
+    /// Cleared rows of `width` pixels, at most `rows` of them.
+    pub fn new(width: usize, rows: usize) -> Accumulator {
+        Accumulator {
+            width,
+            cells: vec![0.0; (width + 2) * rows],
+            touched: vec![Vec::new(); rows],
         }
-        // Ends computed from the segment, not incrementally: the same in every band.
-        let xa = if ya == y0 { x0 } else { x0 + (ya - y0) * dxdy };
-        let xb = if yb == y1 { x1 } else { x0 + (yb - y0) * dxdy };
-        let start = (j - row0) as usize * stride;
-        add_piece(
-            &mut acc[start..start + stride],
-            width as f64,
-            xa,
-            xb,
-            dir * (yb - ya),
-        );
+    }
+
+    /// The widest rows this accumulator holds.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Adds the contribution of `line` to image rows `row0 .. row0 + rows` (accumulator rows
+    /// `0 .. rows`).
+    pub fn add(&mut self, row0: i64, rows: usize, line: &Line) {
+        let ([x0, y0], [x1, y1], dir) = if line.p0[1] < line.p1[1] {
+            (line.p0, line.p1, 1.0)
+        } else if line.p0[1] > line.p1[1] {
+            (line.p1, line.p0, -1.0)
+        } else {
+            return;
+        };
+        let stride = self.width + 2;
+        let dxdy = (x1 - x0) / (y1 - y0);
+        let first = (y0.floor() as i64).max(row0);
+        let last = (y1.ceil() as i64).min(row0 + rows as i64);
+        for j in first..last {
+            let ya = y0.max(j as f64);
+            let yb = y1.min((j + 1) as f64);
+            if yb <= ya {
+                continue;
+            }
+            // Ends computed from the segment, not incrementally: the same in every band.
+            let xa = if ya == y0 { x0 } else { x0 + (ya - y0) * dxdy };
+            let xb = if yb == y1 { x1 } else { x0 + (yb - y0) * dxdy };
+            let r = (j - row0) as usize;
+            let row = &mut self.cells[r * stride..(r + 1) * stride];
+            add_piece(
+                row,
+                self.width as f64,
+                xa,
+                xb,
+                dir * (yb - ya),
+                &mut self.touched[r],
+            );
+        }
+    }
+
+    /// Writes the coverage of columns `c0..c1` of row `r` into `out[c0..c1]` and clears the
+    /// row. Returns the columns `[a, b)` outside which that coverage is zero.
+    ///
+    /// The same sums as a prefix sum over every cell from `c0`: the cells skipped are zero.
+    pub fn resolve(&mut self, r: usize, c0: usize, c1: usize, out: &mut [f32]) -> (usize, usize) {
+        let stride = self.width + 2;
+        let row = &mut self.cells[r * stride..(r + 1) * stride];
+        let runs = &mut self.touched[r];
+        runs.sort_unstable_by_key(|run| run[0]);
+        let mut sum = 0.0;
+        // Columns before `next` are written.
+        let mut next = c0;
+        let (mut a, mut b) = (c1, c0);
+        let mut k = 0;
+        while k < runs.len() {
+            // Overlapping or adjacent runs merge, so each cell is summed once.
+            let [first, mut end] = runs[k];
+            k += 1;
+            while k < runs.len() && runs[k][0] <= end {
+                end = end.max(runs[k][1]);
+                k += 1;
+            }
+            let (s, e) = (first.clamp(next, c1), end.clamp(next, c1));
+            out[next..s].fill(coverage_of(sum));
+            for (o, &v) in out[s..e].iter_mut().zip(&row[s..e]) {
+                sum += v;
+                *o = coverage_of(sum);
+            }
+            if s < e {
+                a = a.min(s);
+                b = e;
+            }
+            next = e;
+            row[first..end].fill(0.0);
+        }
+        runs.clear();
+        let tail = coverage_of(sum);
+        out[next..c1].fill(tail);
+        if tail != 0.0 {
+            (a.min(next), c1)
+        } else {
+            (a, b.max(a))
+        }
     }
 }
 
 /// Adds one piece of a segment within one row: from `xa` to `xb`, spanning `d` (signed) of the
 /// row's height. Parts left of the image count fully for every pixel; parts right of it for none.
-fn add_piece(row: &mut [f64], width: f64, xa: f64, xb: f64, d: f64) {
+/// Records the cells it changes in `touched`.
+fn add_piece(row: &mut [f64], width: f64, xa: f64, xb: f64, d: f64, touched: &mut Vec<[usize; 2]>) {
     let (lo, hi) = if xa <= xb { (xa, xb) } else { (xb, xa) };
     if hi <= 0.0 || lo >= width || hi - lo < 1e-9 {
         let x = (0.5 * (xa + xb)).clamp(0.0, width);
-        add_span(row, x, x, d);
+        touched.push(add_span(row, x, x, d));
         return;
     }
     // Split at the image's left and right edges, sharing `d` in proportion to length.
@@ -83,19 +161,20 @@ fn add_piece(row: &mut [f64], width: f64, xa: f64, xb: f64, d: f64) {
         }
         let part = d * (b - a) / len;
         let (a, b) = (a.clamp(0.0, width), b.clamp(0.0, width));
-        add_span(row, a, b, part);
+        touched.push(add_span(row, a, b, part));
     }
 }
 
 /// Adds a monotone piece from `x0` to `x1` (`x0 <= x1`, both in `0..=width`) spanning `d`.
-fn add_span(row: &mut [f64], x0: f64, x1: f64, d: f64) {
+/// Returns the cells `[first, end)` it changed.
+fn add_span(row: &mut [f64], x0: f64, x1: f64, d: f64) -> [usize; 2] {
     let c0 = x0.floor() as usize;
     if x1 - x0 < 1e-9 {
         // Vertical: the area right of x in cell c0 is c0 + 1 - x.
         let f = (c0 as f64 + 1.0 - x0).clamp(0.0, 1.0);
         row[c0] += d * f;
         row[c0 + 1] += d * (1.0 - f);
-        return;
+        return [c0, c0 + 2];
     }
     let c1 = x1.ceil() as usize;
     let s = d / (x1 - x0);
@@ -111,7 +190,8 @@ fn add_span(row: &mut [f64], x0: f64, x1: f64, d: f64) {
         }
     };
     let mut prev = 0.0;
-    for c in c0..=c1.min(row.len() - 1) {
+    let last = c1.min(row.len() - 1);
+    for c in c0..=last {
         let cf = c as f64;
         let a = if c == c1 {
             d
@@ -121,22 +201,20 @@ fn add_span(row: &mut [f64], x0: f64, x1: f64, d: f64) {
         row[c] += a - prev;
         prev = a;
     }
+    [c0, last + 1]
 }
 
-/// Turns one accumulation row into coverage in `0..=1` by a prefix sum, writing `width` values.
-pub(crate) fn resolve_row(acc: &[f64], out: &mut [f32]) {
-    let mut sum = 0.0;
-    for (o, &a) in out.iter_mut().zip(acc) {
-        sum += a;
-        let c = sum.abs().min(1.0);
-        // Round-off of cancelled contributions is not coverage.
-        *o = if c < 1e-9 {
-            0.0
-        } else if c > 1.0 - 1e-9 {
-            1.0
-        } else {
-            c as f32
-        };
+/// The coverage in `0..=1` of a winding-weighted area.
+#[inline]
+fn coverage_of(sum: f64) -> f32 {
+    let c = sum.abs().min(1.0);
+    // Round-off of cancelled contributions is not coverage.
+    if c < 1e-9 {
+        0.0
+    } else if c > 1.0 - 1e-9 {
+        1.0
+    } else {
+        c as f32
     }
 }
 
@@ -145,17 +223,15 @@ mod tests {
     use super::*;
 
     fn render(lines: &[Line], w: usize, h: usize) -> Vec<f32> {
-        let mut acc = vec![0.0; (w + 2) * h];
+        let mut acc = Accumulator::new(w, h);
         for l in lines {
-            accumulate(&mut acc, w, 0, h, l);
+            acc.add(0, h, l);
         }
         let mut out = vec![0.0; w * h];
         for j in 0..h {
-            resolve_row(
-                &acc[j * (w + 2)..(j + 1) * (w + 2)],
-                &mut out[j * w..(j + 1) * w],
-            );
+            acc.resolve(j, 0, w, &mut out[j * w..(j + 1) * w]);
         }
+        assert!(acc.cells.iter().all(|&c| c == 0.0), "left cleared");
         out
     }
 
@@ -202,6 +278,48 @@ mod tests {
             area += a[0] * b[1] - b[0] * a[1];
         }
         0.5 * area.abs()
+    }
+
+    /// Resolving only the touched runs gives the same bits as a prefix sum over every cell
+    /// from the first column, and nothing outside the range it returns is covered.
+    #[test]
+    fn sparse_resolve_matches_the_dense_prefix_sum() {
+        let outer = [[1.25, 0.5], [37.5, 2.0], [35.0, 11.75], [0.5, 9.5]];
+        let hole = [[8.0, 3.0], [9.0, 8.0], [20.5, 7.5], [21.0, 3.5]];
+        let right = [[26.0, 1.0], [31.0, 1.0], [31.0, 10.0], [26.0, 10.0]];
+        let mut lines = polygon(&outer);
+        lines.extend(polygon(&hole));
+        // A square run the other way: cancels part of the outer loop.
+        lines.extend(
+            polygon(&right)
+                .into_iter()
+                .rev()
+                .map(|l| Line { p0: l.p1, p1: l.p0 }),
+        );
+        let (w, h) = (40, 12);
+        let mut acc = Accumulator::new(w, h);
+        for l in &lines {
+            acc.add(0, h, l);
+        }
+        for (c0, c1) in [(0, w), (3, 33), (10, 12), (39, 40), (5, 5)] {
+            let mut copy = acc.clone();
+            for j in 0..h {
+                let cells = copy.cells[j * (w + 2)..(j + 1) * (w + 2)].to_vec();
+                let mut out = vec![-1.0; w];
+                let (a, b) = copy.resolve(j, c0, c1, &mut out);
+                let mut sum = 0.0;
+                for i in c0..c1 {
+                    sum += cells[i];
+                    assert_eq!(out[i], coverage_of(sum), "row {j} column {i} of {c0}..{c1}");
+                    if !(a..b).contains(&i) {
+                        assert_eq!(out[i], 0.0, "row {j} column {i} outside {a}..{b}");
+                    }
+                }
+                assert!(out[..c0].iter().chain(&out[c1..]).all(|&v| v == -1.0));
+            }
+            assert!(copy.cells.iter().all(|&c| c == 0.0), "left cleared");
+            assert!(copy.touched.iter().all(Vec::is_empty));
+        }
     }
 
     #[test]

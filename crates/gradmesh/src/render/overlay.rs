@@ -4,7 +4,7 @@ use crate::error::{Error, ErrorKind};
 use crate::mesh::Document;
 use crate::refine::Refinement;
 
-use super::coverage::{accumulate, resolve_row, Line};
+use super::coverage::{Accumulator, Line};
 use super::outline::{boundary_loops, outline};
 use super::output::Image;
 use super::view::ToPixels;
@@ -68,13 +68,13 @@ pub fn draw_outlines(doc: &Document, opts: &RenderOptions, image: &mut Image) ->
         }
     }
     let (w, h) = (opts.width as usize, opts.height as usize);
-    let mut acc = vec![0.0; (w + 2) * h];
+    let mut acc = Accumulator::new(w, h);
     for l in &lines {
-        accumulate(&mut acc, w, 0, h, l);
+        acc.add(0, h, l);
     }
     let mut cov = vec![0.0f32; w];
     for j in 0..h {
-        resolve_row(&acc[j * (w + 2)..(j + 1) * (w + 2)], &mut cov);
+        acc.resolve(j, 0, w, &mut cov);
         for (i, &a) in cov.iter().enumerate() {
             if a == 0.0 {
                 continue;
