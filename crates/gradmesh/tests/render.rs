@@ -581,6 +581,11 @@ fn output_types_agree() {
     gradmesh::render::render_document_into(&d, &opts, &mut b16).unwrap();
     assert_eq!(b8, img.to_u8(false));
     assert_eq!(b16, img.to_u16());
+    // Dithered as the float image would be (the 8-bit encoding saturates by itself: the
+    // renderer does not clamp before it).
+    opts.dither = true;
+    gradmesh::render::render_document_into(&d, &opts, &mut b8).unwrap();
+    assert_eq!(b8, img.to_u8(true));
     let mut wrong = vec![0u8; 5];
     assert!(gradmesh::render::render_document_into(&d, &opts, &mut wrong).is_err());
 }

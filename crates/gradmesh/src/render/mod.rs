@@ -791,7 +791,7 @@ fn draw_band<P: OutputPixel>(
         let pixels = row_out.chunks_exact_mut(4).zip(row_colour);
         if dither {
             for (x, (px, c)) in pixels.enumerate() {
-                let rgba = straight_srgb(c, linear);
+                let rgba = straight_srgb::<P>(c, linear);
                 let noise = output::dither_noise(x as u32, y);
                 for ch in 0..4 {
                     px[ch] = P::encode(rgba[ch], noise[ch]);
@@ -799,7 +799,7 @@ fn draw_band<P: OutputPixel>(
             }
         } else {
             for (px, c) in pixels {
-                let rgba = straight_srgb(c, linear);
+                let rgba = straight_srgb::<P>(c, linear);
                 for ch in 0..4 {
                     px[ch] = P::encode(rgba[ch], 0.0);
                 }
@@ -808,10 +808,11 @@ fn draw_band<P: OutputPixel>(
     }
 }
 
-/// A premultiplied colour of the blend space as straight-alpha, sRGB-encoded channels.
+/// A premultiplied colour of the blend space as straight-alpha, sRGB-encoded channels, ready
+/// for `P::encode` (clamped to `0..=1` unless that saturates by itself).
 // Always inlined: called once per pixel from two loops, it was left as a call.
 #[inline(always)]
-fn straight_srgb(c: &[f32; 4], linear: bool) -> [f32; 4] {
+fn straight_srgb<P: OutputPixel>(c: &[f32; 4], linear: bool) -> [f32; 4] {
     let a = c[3];
     if a.is_nan() || a <= 0.0 {
         return [0.0; 4];
@@ -821,8 +822,13 @@ fn straight_srgb(c: &[f32; 4], linear: bool) -> [f32; 4] {
     let mut out = [1.0f32; 4];
     for ch in 0..3 {
         let v = if opaque { c[ch] } else { c[ch] / a };
-        let v = v.clamp(0.0, 1.0);
-        out[ch] = if linear { gamut::srgb_encode_f32(v) } else { v };
+        out[ch] = if linear {
+            gamut::srgb_encode_f32(v.clamp(0.0, 1.0))
+        } else if P::SATURATES {
+            v
+        } else {
+            v.clamp(0.0, 1.0)
+        };
     }
     if !opaque {
         out[3] = a;

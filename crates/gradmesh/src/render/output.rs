@@ -9,6 +9,9 @@ use crate::error::{Error, ErrorKind};
 pub trait OutputPixel: Copy + Send + Sync + 'static {
     /// Whether this type is coarse enough to be dithered (8-bit).
     const DITHERED: bool;
+    /// Whether [`OutputPixel::encode`] gives values below 0 (and NaN) the code of 0, and values
+    /// above 1 that of 1, so that callers need not clamp first.
+    const SATURATES: bool;
 
     /// Encodes a value in `0..=1`. `noise` (in `-1..1`, units of one output step) is added
     /// before rounding by types that dither; values exactly 0 or 1 are never dithered, so flat
@@ -18,6 +21,7 @@ pub trait OutputPixel: Copy + Send + Sync + 'static {
 
 impl OutputPixel for f32 {
     const DITHERED: bool = false;
+    const SATURATES: bool = false;
     #[inline(always)]
     fn encode(v: f32, _noise: f32) -> Self {
         v
@@ -26,6 +30,7 @@ impl OutputPixel for f32 {
 
 impl OutputPixel for u16 {
     const DITHERED: bool = false;
+    const SATURATES: bool = true;
     #[inline(always)]
     fn encode(v: f32, _noise: f32) -> Self {
         (v.clamp(0.0, 1.0) * 65535.0 + 0.5) as u16
@@ -34,6 +39,7 @@ impl OutputPixel for u16 {
 
 impl OutputPixel for u8 {
     const DITHERED: bool = true;
+    const SATURATES: bool = true;
     #[inline(always)]
     fn encode(v: f32, noise: f32) -> Self {
         if v <= 0.0 {
@@ -213,6 +219,37 @@ fn write_png(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The types that say they saturate encode any value as its clamped value.
+    #[test]
+    fn saturating_types_need_no_clamp() {
+        fn check<P: OutputPixel + PartialEq + std::fmt::Debug>() {
+            assert!(P::SATURATES);
+            let values = [
+                f32::NAN,
+                f32::NEG_INFINITY,
+                -3.0,
+                -1e-7,
+                -0.0,
+                0.0,
+                0.3,
+                1.0,
+            ];
+            let values = values.iter().chain(&[1.0 + 1e-7, 1.5, f32::INFINITY]);
+            for &v in values {
+                for noise in [-0.99, 0.0, 0.5] {
+                    let clamped = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+                    assert_eq!(
+                        P::encode(v, noise),
+                        P::encode(clamped, noise),
+                        "{v} {noise}"
+                    );
+                }
+            }
+        }
+        check::<u8>();
+        check::<u16>();
+    }
 
     #[test]
     fn noise_is_triangular_and_centred() {
