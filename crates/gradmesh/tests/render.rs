@@ -590,6 +590,45 @@ fn output_types_agree() {
     assert!(gradmesh::render::render_document_into(&d, &opts, &mut wrong).is_err());
 }
 
+/// Rows below the drawing (bands no layer reaches, written as one encoded pixel) hold the
+/// background, in every output type, as the float image's encodings of it.
+#[test]
+fn rows_without_layers_are_the_background() {
+    let d = doc(vec![star(Point::new(30.0, 30.0), 25.0)]);
+    for background in [
+        None,
+        Some([0.2, 0.45, 0.9, 0.6]),
+        Some([1.0, 1.0, 1.0, 1.0]),
+    ] {
+        let mut opts = RenderOptions::new(60, 150, View::new(0.0, 0.0, 60.0, 150.0));
+        opts.background = background;
+        for dither in [false, true] {
+            opts.dither = dither;
+            let img = render_document(&d, &opts).unwrap();
+            let bg = background.map_or([0.0f32; 4], |b| b.map(|v| v as f32));
+            let bg = if bg[3] == 0.0 { [0.0; 4] } else { bg };
+            // Below the star (rows 64 on are four bands of 16 that it does not reach).
+            for y in 64..150 {
+                for x in 0..60 {
+                    let px = img.pixel(x, y);
+                    for c in 0..4 {
+                        assert!(
+                            (px[c] - bg[c]).abs() < 1e-6,
+                            "{background:?} ({x}, {y}): {px:?}"
+                        );
+                    }
+                }
+            }
+            let mut b8 = vec![0u8; img.data.len()];
+            let mut b16 = vec![0u16; img.data.len()];
+            gradmesh::render::render_document_into(&d, &opts, &mut b8).unwrap();
+            gradmesh::render::render_document_into(&d, &opts, &mut b16).unwrap();
+            assert_eq!(b8, img.to_u8(dither), "{background:?} dither {dither}");
+            assert_eq!(b16, img.to_u16(), "{background:?}");
+        }
+    }
+}
+
 /// A handle pointing backwards folds the surface; `find_folds` finds it, and nothing on a plain
 /// grid.
 #[test]

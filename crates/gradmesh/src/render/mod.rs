@@ -627,6 +627,22 @@ fn draw_band<P: OutputPixel>(
     let w = opts.width as usize;
     let y0 = band * BAND;
     let rows = out.len() / (4 * w);
+    let dither = opts.dither && P::DITHERED;
+    let linear = opts.blend == BlendSpace::Linear;
+
+    // Rows no layer reaches (a canvas larger than the drawing) are the background: one pixel,
+    // encoded once, unless dithering would give each of them its own noise.
+    if layers.iter().all(|l| l.line_bins.get(band).is_empty()) {
+        let rgba = straight_srgb::<P>(&background.unwrap_or([0.0; 4]), linear);
+        if !dither || rgba.iter().all(|&v| v == 0.0 || v == 1.0) {
+            let pixel = each4(|ch| P::encode(rgba[ch], 0.0));
+            for px in out.chunks_exact_mut(4) {
+                px.copy_from_slice(&pixel);
+            }
+            return;
+        }
+    }
+
     let colour = &mut s.colour[..w * rows];
     colour.fill([0.0; 4]);
     s.opaque[..w * rows].fill(false);
@@ -780,8 +796,6 @@ fn draw_band<P: OutputPixel>(
     }
 
     // Straight alpha, sRGB-encoded.
-    let dither = opts.dither && P::DITHERED;
-    let linear = opts.blend == BlendSpace::Linear;
     for (r, (row_out, row_colour)) in out
         .chunks_exact_mut(4 * w)
         .zip(colour.chunks_exact(w))
