@@ -613,7 +613,7 @@ struct Run {
 }
 
 /// Draws rows `band * BAND ..` of every layer into `out`.
-// Not inlined into the rayon closure: inlined there, its loops were compiled worse (10 % more
+// Not inlined into the rayon closure: inlined there, its loops were compiled worse (7 % more
 // instructions for the `vs_cairo` scene, seen with callgrind).
 #[inline(never)]
 fn draw_band<P: OutputPixel>(
