@@ -275,6 +275,32 @@ struct Tile {
     v: [i64; 2],
 }
 
+impl Tile {
+    /// The four quads this one becomes one level down, whose faces there start at `first`,
+    /// placed in the grid of the next depth (twice as fine). Child `c` sits at corner `c`, its
+    /// first side along side `c`, its last along side `c - 1`.
+    fn children(&self, first: usize) -> [Tile; 4] {
+        let o = [2 * self.origin[0], 2 * self.origin[1]];
+        let (u, v) = (self.u, self.v);
+        let corners = [
+            o,
+            [o[0] + 2 * u[0], o[1] + 2 * u[1]],
+            [o[0] + 2 * (u[0] + v[0]), o[1] + 2 * (u[1] + v[1])],
+            [o[0] + 2 * v[0], o[1] + 2 * v[1]],
+        ];
+        super::each4(|c| {
+            let p = corners[c];
+            let towards = |q: [i64; 2]| [(q[0] - p[0]) / 2, (q[1] - p[1]) / 2];
+            Tile {
+                face: (first + c) as u32,
+                origin: p,
+                u: towards(corners[(c + 1) % 4]),
+                v: towards(corners[(c + 3) % 4]),
+            }
+        })
+    }
+}
+
 /// One depth of a locally refined face.
 struct LocalLevel {
     /// The faces around `tiles`, as their own mesh (`None` when no tile is left).
@@ -439,29 +465,7 @@ impl LocalPatch {
         let child_data = stencils.apply(last_data);
         let mut tiles = Vec::with_capacity(4 * last.tiles.len());
         for tile in &last.tiles {
-            // Corners in the grid of the next depth (twice as fine).
-            let o = [2 * tile.origin[0], 2 * tile.origin[1]];
-            let corners = [
-                o,
-                [o[0] + 2 * tile.u[0], o[1] + 2 * tile.u[1]],
-                [
-                    o[0] + 2 * (tile.u[0] + tile.v[0]),
-                    o[1] + 2 * (tile.u[1] + tile.v[1]),
-                ],
-                [o[0] + 2 * tile.v[0], o[1] + 2 * tile.v[1]],
-            ];
-            let first = last_level.topology.face_offset(tile.face as usize);
-            // Child c sits at corner c, its first side along side c, its last along side c - 1.
-            for c in 0..4 {
-                let p = corners[c];
-                let towards = |q: [i64; 2]| [(q[0] - p[0]) / 2, (q[1] - p[1]) / 2];
-                tiles.push(Tile {
-                    face: (first + c) as u32,
-                    origin: p,
-                    u: towards(corners[(c + 1) % 4]),
-                    v: towards(corners[(c + 3) % 4]),
-                });
-            }
+            tiles.extend(tile.children(last_level.topology.face_offset(tile.face as usize)));
         }
         let mut patches = Vec::new();
         tiles.retain(|tile| {
@@ -698,28 +702,10 @@ mod tests {
             v: [0, 1],
         }];
         for _ in 0..n.trailing_zeros() {
-            let mut children = Vec::new();
-            for tile in &tiles {
-                let first = level.topology.face_offset(tile.face as usize);
-                let o = [2 * tile.origin[0], 2 * tile.origin[1]];
-                let (u, v) = (tile.u, tile.v);
-                let corners = [
-                    o,
-                    [o[0] + 2 * u[0], o[1] + 2 * u[1]],
-                    [o[0] + 2 * (u[0] + v[0]), o[1] + 2 * (u[1] + v[1])],
-                    [o[0] + 2 * v[0], o[1] + 2 * v[1]],
-                ];
-                for c in 0..4 {
-                    let p = corners[c];
-                    let towards = |q: [i64; 2]| [(q[0] - p[0]) / 2, (q[1] - p[1]) / 2];
-                    children.push(Tile {
-                        face: (first + c) as u32,
-                        origin: p,
-                        u: towards(corners[(c + 1) % 4]),
-                        v: towards(corners[(c + 3) % 4]),
-                    });
-                }
-            }
+            let children: Vec<Tile> = tiles
+                .iter()
+                .flat_map(|t| t.children(level.topology.face_offset(t.face as usize)))
+                .collect();
             let (child, stencils) = refine(&level);
             data = stencils.apply(&data);
             level = child;
