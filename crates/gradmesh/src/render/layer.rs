@@ -17,7 +17,7 @@ use super::adaptive;
 use super::coverage::Line;
 use super::nearest::{NearestSegments, Segment};
 use super::outline::{boundary_loops, outline};
-use super::triangles::{snap, Triangle, TriangleList, SUBPIXEL};
+use super::triangles::{snap, Bounds, Triangle, TriangleList, SUBPIXEL};
 use super::view::ToPixels;
 use super::{each3, each4, LayerInfo, LayerTimings, RenderOptions};
 
@@ -91,6 +91,8 @@ pub(crate) struct PreparedLayer {
     pub nearest: NearestSegments,
     /// Columns `[start, end)` where coverage can be non-zero.
     pub columns: (usize, usize),
+    /// The colour bounds of a layer with quadratic triangles (see [`Bounds`]).
+    pub bounds: Option<Bounds>,
 }
 
 /// The mesh with its colours converted to `space` (so that they are interpolated there).
@@ -134,6 +136,8 @@ pub(super) struct Thresholds {
     pub size: (f64, f64),
     /// The working colour space.
     pub space: ColourSpace,
+    /// Whether faces may take quadratic colour ([`RenderOptions::quadratic`]).
+    pub quadratic: bool,
 }
 
 impl Thresholds {
@@ -145,6 +149,7 @@ impl Thresholds {
             min_quad: MIN_QUAD_PX,
             size: (opts.width as f64, opts.height as f64),
             space,
+            quadratic: opts.quadratic,
         }
     }
 }
@@ -292,7 +297,7 @@ pub(super) struct QuadSamples<'a> {
 /// The colour error of `shown` against the limit `sample`: exact, or through the derivative
 /// `jacobian` of the working space to Lab at the sample. Errors worth measuring are a few Lab
 /// units, where the two agree to a fraction of a percent.
-fn sample_error(
+pub(super) fn sample_error(
     space: ColourSpace,
     sample: [f64; 4],
     shown: [f64; 4],
@@ -513,11 +518,12 @@ fn choose_level(
     }
 }
 
-/// The triangle through three points (pixels) with attributes `attr`, snapped, if it may
-/// cover a pixel centre of a `size` image.
+/// The triangle through three points (pixels) with attributes `attr` (and quadratic, with the
+/// side nodes `mids`), snapped, if it may cover a pixel centre of a `size` image.
 pub(super) fn screen_triangle_px(
     exact: [[f64; 2]; 3],
     attr: [[f64; 4]; 3],
+    mids: Option<[[f64; 4]; 3]>,
     size: (i64, i64),
 ) -> Option<Triangle> {
     let (w, h) = size;
@@ -538,7 +544,7 @@ pub(super) fn screen_triangle_px(
     if outside || no_column {
         return None;
     }
-    let tri = Triangle::new(v, exact, attr)?;
+    let tri = Triangle::new_quadratic(v, exact, attr, mids)?;
     let rows = tri.rows();
     (rows.1 > 0 && rows.0 < h && rows.0 < rows.1).then_some(tri)
 }
@@ -562,7 +568,7 @@ fn uniform_triangles(
         (1..fv.len() - 1)
             .filter_map(|i| {
                 let idx = [fv[0], fv[i], fv[i + 1]];
-                screen_triangle_px(idx.map(|i| exact[i as usize]), idx.map(attr), size)
+                screen_triangle_px(idx.map(|i| exact[i as usize]), idx.map(attr), None, size)
             })
             .collect()
     };
@@ -587,6 +593,7 @@ fn uniform_triangles(
                     b: exact[b as usize],
                     ca: c(a),
                     cb: c(b),
+                    bump: [0.0; 4],
                 });
             }
         }
@@ -638,7 +645,7 @@ pub(crate) fn prepare(
     } else {
         adaptive::tessellate(&mut refinement, &mut data, xf, &th, opts.max_level, (w, h))
     };
-    let (k, triangles, segments, mut info) = match fast {
+    let (k, triangles, segments, bounds, mut info) = match fast {
         Some(tess) => {
             timings.evaluate = start.elapsed();
             let info = LayerInfo {
@@ -653,7 +660,13 @@ pub(crate) fn prepare(
                 timings,
                 reused: false,
             };
-            (tess.base_level, tess.triangles, tess.segments, info)
+            (
+                tess.base_level,
+                tess.triangles,
+                tess.segments,
+                tess.bounds,
+                info,
+            )
         }
         None => {
             let (choice, lim) = choose_level(&mut refinement, &mut data, xf, opts, space);
@@ -672,7 +685,7 @@ pub(crate) fn prepare(
                 timings,
                 reused: false,
             };
-            (choice.level, triangles, segments, info)
+            (choice.level, triangles, segments, None, info)
         }
     };
     let start = Instant::now();
@@ -743,6 +756,7 @@ pub(crate) fn prepare(
         line_bins,
         nearest,
         columns,
+        bounds,
     };
     Ok((info, Some(layer), warnings))
 }

@@ -23,6 +23,11 @@
 //!      sides use bit-identical samples along it, and the coarser side fans its boundary cells
 //!      out to them. Cells are drawn in the order and with the diagonals of the quads uniform
 //!      refinement would make (see `adaptive.rs`).
+//!      A face whose cells fail with linear colour is also measured with *quadratic* colour
+//!      (six-node triangles, see `quadratic.rs`; [`RenderOptions::quadratic`]) against the
+//!      surface at the triangles' quarter points, and keeps whichever passes first: where
+//!      colour is smooth, quadratic pieces converge as the cube of the cell size and need far
+//!      fewer cells; near extraordinary vertices and folds the faces stay linear.
 //!      Faces whose control points all lie off the image are not refined.
 //!    - **Uniform path** (reference mode, [`RenderOptions::level`], a
 //!      [`RenderOptions::max_level`] under 3, or a layer the fast path does not handle). The
@@ -39,8 +44,10 @@
 //!    ([`RenderOptions::max_level`], [`RenderOptions::max_quads`]) stopped it, and the time of
 //!    each stage ([`LayerTimings`], [`RenderTimings`]).
 //! 2. **Interior.** Every quad (cell), with the limit positions and colours of its corners, is
-//!    drawn as two triangles; colour and opacity are interpolated linearly in the
-//!    mesh's working space at each pixel centre and only then converted. Vertices are snapped to
+//!    drawn as two triangles; colour and opacity are interpolated linearly (quadratically on a
+//!    quadratic face, through the nodes at the sides' midpoints, which two triangles sharing a
+//!    side share bit for bit) in the mesh's working space at each pixel centre and only then
+//!    converted. Vertices are snapped to
 //!    1/256 pixel and tested with exact integer edge functions and the top-left rule, so interior
 //!    edges have neither gaps nor double coverage. Where the surface folds over itself, later
 //!    faces cover earlier ones (face order of the refinement; see [`find_folds`]).
@@ -93,6 +100,7 @@ mod outline;
 mod output;
 mod overlay;
 mod patches;
+mod quadratic;
 mod triangles;
 mod view;
 
@@ -167,6 +175,10 @@ pub struct RenderOptions {
     /// The largest image accepted, in pixels (default [`MAX_PIXELS`]): a larger request is
     /// refused before anything is allocated.
     pub max_pixels: u64,
+    /// Let the fast path interpolate colour quadratically over the triangles of faces where
+    /// that passes the colour tolerance with fewer cells than linear colour (default `true`).
+    /// `false` draws every face with linear colour, as before 2026-12.
+    pub quadratic: bool,
 }
 
 impl Default for RenderOptions {
@@ -188,6 +200,7 @@ impl Default for RenderOptions {
             blend: BlendSpace::default(),
             dither: true,
             max_pixels: MAX_PIXELS,
+            quadratic: true,
         }
     }
 }
@@ -661,6 +674,15 @@ fn draw_band<P: OutputPixel>(
         }
         let (c0, c1) = layer.columns;
         let converter = gamut::RunConverter::new(layer.space, opts.gamut, opts.blend);
+        let bounds = layer.bounds.as_ref().unwrap_or(&triangles::UNBOUNDED);
+        // Outline colours of a layer with quadratic sides are clamped as its triangles are.
+        let nearest = |p: [f64; 2]| {
+            let a = layer.nearest.attributes_at(p)?;
+            Some(match layer.bounds {
+                Some(b) => each4(|k| a[k].clamp(b[0][k], b[1][k])),
+                None => a,
+            })
+        };
         for r in 0..rows {
             s.covered[r * w + c0..r * w + c1].fill(false);
         }
@@ -677,7 +699,7 @@ fn draw_band<P: OutputPixel>(
                 let row = (j as usize - y0) * w;
                 let y = j as f64 + 0.5;
                 let span = row + a..row + b;
-                t.fill_row(y, a as f64 + 0.5, &mut s.attributes[span.clone()]);
+                t.fill_row(y, a as f64 + 0.5, &mut s.attributes[span.clone()], bounds);
                 s.covered[span].fill(true);
             });
         }
@@ -710,7 +732,7 @@ fn draw_band<P: OutputPixel>(
                         let attr = if s.covered[k] {
                             s.attributes[k]
                         } else {
-                            match layer.nearest.attributes_at([(i - 1) as f64 + 0.5, y]) {
+                            match nearest([(i - 1) as f64 + 0.5, y]) {
                                 Some(a) => a,
                                 None => continue,
                             }
@@ -754,7 +776,7 @@ fn draw_band<P: OutputPixel>(
                     let attr = if s.covered[k] {
                         s.attributes[k]
                     } else {
-                        match layer.nearest.attributes_at([i as f64 + 0.5, y]) {
+                        match nearest([i as f64 + 0.5, y]) {
                             Some(a) => a,
                             None => continue,
                         }

@@ -15,6 +15,9 @@ pub(crate) struct Segment {
     pub b: [f64; 2],
     pub ca: [f32; 4],
     pub cb: [f32; 4],
+    /// The quadratic part: `bump t (1 - t)` is added at `t` along the segment (zero on a
+    /// linear one, four times the midpoint's distance from the mean of the ends otherwise).
+    pub bump: [f32; 4],
 }
 
 /// Boundary edges bucketed in a uniform grid.
@@ -171,7 +174,7 @@ impl NearestSegments {
         let t = t as f32;
         let mut out = [0.0f32; 4];
         for k in 0..4 {
-            out[k] = seg.ca[k] + t * (seg.cb[k] - seg.ca[k]);
+            out[k] = seg.ca[k] + t * (seg.cb[k] - seg.ca[k]) + seg.bump[k] * (t * (1.0 - t));
         }
         Some(out)
     }
@@ -196,6 +199,7 @@ mod tests {
                 b: pt(k + 1),
                 ca: [k as f32, 0.0, 0.0, 1.0],
                 cb: [(k + 1) as f32, 0.0, 0.0, 1.0],
+                bump: [0.0; 4],
             });
         }
         let grid = NearestSegments::new(segs.clone());

@@ -1,5 +1,5 @@
-//! Triangles with linearly interpolated attributes, rasterised at pixel centres with an exact
-//! fill rule.
+//! Triangles with linearly or quadratically interpolated attributes, rasterised at pixel
+//! centres with an exact fill rule.
 //!
 //! Vertices are snapped to 1/256 pixel and edge functions are evaluated in integers, so two
 //! triangles that share an edge (the same two snapped vertices) decide every pixel centre on it
@@ -56,9 +56,10 @@ impl Edge {
     }
 }
 
-/// A positively oriented triangle with four attributes varying linearly over it.
+/// A positively oriented triangle with four attributes varying over it as polynomials of degree
+/// two (a linear triangle's quadratic terms are zero).
 ///
-/// Kept small (104 bytes): a dense layer has tens of thousands of triangles, written once and
+/// Kept small (152 bytes): a dense layer has tens of thousands of triangles, written once and
 /// read once per band, and the fresh pages they take cost more than building them.
 #[derive(Clone, Debug)]
 pub(crate) struct Triangle {
@@ -75,7 +76,23 @@ pub(crate) struct Triangle {
     at_origin: [f32; 4],
     gx: [f32; 4],
     gy: [f32; 4],
+    /// The quadratic terms: `+ qxx (x - ox)^2 + qxy (x - ox) (y - oy) + qyy (y - oy)^2`, all
+    /// zero on a linear triangle (adding them then changes no bit of its attributes).
+    qxx: [f32; 4],
+    qxy: [f32; 4],
+    qyy: [f32; 4],
+    /// Whether there are quadratic terms: a quadratic triangle's values are clamped to the
+    /// layer's colour bounds (it may overshoot them slightly between its nodes; a linear one
+    /// cannot).
+    quadratic: bool,
 }
+
+/// Per attribute, the smallest and the largest value of a layer's colours in play: quadratic
+/// pixels are clamped to them, so that no pixel leaves the box around the control colours.
+pub(crate) type Bounds = [[f32; 4]; 2];
+
+/// Bounds that clamp nothing.
+pub(crate) const UNBOUNDED: Bounds = [[f32::NEG_INFINITY; 4], [f32::INFINITY; 4]];
 
 /// Rows are kept within this magnitude: images are at most 2^16 rows tall.
 const ROW_CLAMP: i64 = 1 << 30;
@@ -177,7 +194,21 @@ impl Triangle {
     /// units): snapping decides which pixel centres are inside, but moving the colours with the
     /// vertices would shift the colour field by up to 1/512 pixel, which the gradient of a
     /// gradient mesh turns into visible 16-bit noise.
+    #[cfg(test)]
     pub fn new(v: [[i64; 2]; 3], exact: [[f64; 2]; 3], attr: [[f64; 4]; 3]) -> Option<Triangle> {
+        Self::new_quadratic(v, exact, attr, None)
+    }
+
+    /// As [`Triangle::new`], and with `mids` quadratic: `mids[k]` are the attributes at the
+    /// midpoint of the exact side from vertex `k` to vertex `k + 1` (the six nodes of a
+    /// quadratic Lagrange triangle). Two triangles that share a side and its three nodes agree
+    /// all along it.
+    pub fn new_quadratic(
+        v: [[i64; 2]; 3],
+        exact: [[f64; 2]; 3],
+        attr: [[f64; 4]; 3],
+        mids: Option<[[f64; 4]; 3]>,
+    ) -> Option<Triangle> {
         let cross = |a: [i64; 2], b: [i64; 2], c: [i64; 2]| -> i128 {
             (b[0] - a[0]) as i128 * (c[1] - a[1]) as i128
                 - (b[1] - a[1]) as i128 * (c[0] - a[0]) as i128
@@ -206,12 +237,11 @@ impl Triangle {
         let [a, b, c] = exact;
         let (e1, e2) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
         let det = e1[0] * e2[1] - e1[1] * e2[0];
-        let mut at_origin = [0.0; 4];
-        let mut gx = [0.0; 4];
-        let mut gy = [0.0; 4];
+        // Coefficients of 1, x, y, x^2, x y, y^2 (offsets from the origin) per attribute.
+        let mut poly = [[0.0f64; 4]; 6];
         if det == 0.0 || !det.is_finite() {
             for k in 0..4 {
-                at_origin[k] = ((attr[0][k] + attr[1][k] + attr[2][k]) / 3.0) as f32;
+                poly[0][k] = (attr[0][k] + attr[1][k] + attr[2][k]) / 3.0;
             }
         } else {
             // From the first vertex, which lies within a pixel of the origin.
@@ -222,18 +252,63 @@ impl Triangle {
                     (d1 * e2[1] - d2 * e1[1]) / det,
                     (d2 * e1[0] - d1 * e2[0]) / det,
                 );
-                at_origin[k] = (attr[0][k] + sx * dx + sy * dy) as f32;
-                gx[k] = sx as f32;
-                gy[k] = sy as f32;
+                poly[0][k] = attr[0][k] + sx * dx + sy * dy;
+                poly[1][k] = sx;
+                poly[2][k] = sy;
+            }
+            if let Some(mids) = mids {
+                // Barycentric coordinates as affine functions of the offset from the origin:
+                // (constant, d/dx, d/dy).
+                let l1 = [(dx * e2[1] - dy * e2[0]) / det, e2[1] / det, -e2[0] / det];
+                let l2 = [(e1[0] * dy - e1[1] * dx) / det, -e1[1] / det, e1[0] / det];
+                let l0 = [1.0 - l1[0] - l2[0], -l1[1] - l2[1], -l1[2] - l2[2]];
+                let l = [l0, l1, l2];
+                // The quadratic triangle is the linear one plus a bump `4 l_i l_j` per side,
+                // weighted by how far the side's midpoint value lies off the mean of its ends.
+                for side in 0..3 {
+                    let (p, q) = (l[side], l[(side + 1) % 3]);
+                    let bump = [
+                        p[0] * q[0],
+                        p[0] * q[1] + p[1] * q[0],
+                        p[0] * q[2] + p[2] * q[0],
+                        p[1] * q[1],
+                        p[1] * q[2] + p[2] * q[1],
+                        p[2] * q[2],
+                    ];
+                    let (ci, cj) = (attr[side], attr[(side + 1) % 3]);
+                    for k in 0..4 {
+                        let w = 4.0 * (mids[side][k] - 0.5 * (ci[k] + cj[k]));
+                        for (n, t) in bump.iter().enumerate() {
+                            poly[n][k] += w * t;
+                        }
+                    }
+                }
             }
         }
+        let single = |n: usize| each4(|k| poly[n][k] as f32);
         Some(Triangle {
             v,
             rows,
-            at_origin,
-            gx,
-            gy,
+            at_origin: single(0),
+            gx: single(1),
+            gy: single(2),
+            qxx: single(3),
+            qxy: single(4),
+            qyy: single(5),
+            quadratic: mids.is_some(),
         })
+    }
+
+    /// The snapped vertices, in sub-pixel units.
+    #[cfg(test)]
+    pub fn vertices(&self) -> [[i64; 2]; 3] {
+        self.v
+    }
+
+    /// Whether the attributes have quadratic terms.
+    #[cfg(test)]
+    pub fn is_quadratic(&self) -> bool {
+        self.quadratic
     }
 
     /// The first row and one past the last whose pixel centres may lie inside.
@@ -382,23 +457,37 @@ impl Triangle {
     /// The attributes at pixel coordinates `(x, y)`.
     #[cfg(test)]
     pub fn eval(&self, x: f64, y: f64) -> [f32; 4] {
-        self.fill_row(y, x, &mut [[0.0; 4]])[0]
+        self.fill_row(y, x, &mut [[0.0; 4]], &UNBOUNDED)[0]
     }
 
     /// Writes the attributes at the pixel centres `x0, x0 + 1, ..` of row `y` (pixel
-    /// coordinates of the centres) into `out`: the row's constant part once, then one
-    /// multiply-add per attribute and pixel, in single precision.
+    /// coordinates of the centres) into `out`: the row's polynomial in `x` once, then two
+    /// multiply-adds per attribute and pixel, in single precision. On a linear triangle the
+    /// quadratic terms are zero and the values are the plane's, bit for bit; a quadratic one's
+    /// are clamped to `bounds`.
     #[inline]
-    pub fn fill_row<'a>(&self, y: f64, x0: f64, out: &'a mut [[f32; 4]]) -> &'a [[f32; 4]] {
+    pub fn fill_row<'a>(
+        &self,
+        y: f64,
+        x0: f64,
+        out: &'a mut [[f32; 4]],
+        bounds: &Bounds,
+    ) -> &'a [[f32; 4]] {
         let o = self.origin();
         // Exact while the row lies within 2^23 pixels of the origin (a triangle with a vertex
         // near the image); farther, the rounding is a fraction of the gradient's change over
         // the triangle.
         let (dy, dx0) = ((y - o[1]) as f32, (x0 - o[0]) as f32);
-        let row: [f32; 4] = each4(|k| self.at_origin[k] + self.gy[k] * dy);
+        let row: [f32; 4] = each4(|k| self.at_origin[k] + self.gy[k] * dy + self.qyy[k] * dy * dy);
+        let slope: [f32; 4] = each4(|k| self.gx[k] + self.qxy[k] * dy);
         for (n, out) in out.iter_mut().enumerate() {
             let dx = dx0 + n as f32;
-            *out = each4(|k| row[k] + self.gx[k] * dx);
+            *out = each4(|k| row[k] + (slope[k] + self.qxx[k] * dx) * dx);
+        }
+        if self.quadratic {
+            for v in out.iter_mut() {
+                *v = each4(|k| v[k].clamp(bounds[0][k], bounds[1][k]));
+            }
         }
         out
     }
@@ -634,6 +723,62 @@ mod tests {
                         got[k]
                     );
                 }
+            }
+        }
+    }
+
+    /// A quadratic triangle reproduces any quadratic field from its six nodes, near the
+    /// image's origin and far from it, whichever way round its vertices are given.
+    #[test]
+    fn quadratic_triangles_reproduce_quadratic_fields() {
+        let field = |x: f64, y: f64, k: usize| -> f64 {
+            let (x, y) = (x * 0.05, y * 0.05);
+            [
+                40.0 + 3.0 * x - 2.0 * y + 0.7 * x * x - 1.1 * x * y + 0.4 * y * y,
+                -20.0 + x * y - 0.3 * y * y,
+                10.0 - 0.9 * x * x + 2.0 * y,
+                1.0 - 0.01 * x * y,
+            ][k]
+        };
+        for (x0, y0) in [(0.0, 0.0), (2000.25, -731.6)] {
+            let mut exact = [
+                [x0 + 0.3, y0 + 0.1],
+                [x0 + 17.9, y0 + 3.2],
+                [x0 + 5.2, y0 + 14.7],
+            ];
+            for flip in [false, true] {
+                if flip {
+                    exact.swap(1, 2);
+                }
+                let attr = exact.map(|p| each4(|k| field(p[0], p[1], k)));
+                let mids = [0, 1, 2].map(|i| {
+                    let (a, b) = (exact[i], exact[(i + 1) % 3]);
+                    each4(|k| field(0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), k))
+                });
+                let v = exact.map(|q| p(q[0], q[1]));
+                let t = Triangle::new_quadratic(v, exact, attr, Some(mids)).unwrap();
+                let linear = Triangle::new(v, exact, attr).unwrap();
+                let mut off_plane = 0.0f64;
+                for (u, w) in [(0.2, 0.3), (0.5, 0.25), (0.1, 0.8), (0.33, 0.33)] {
+                    let x = exact[0][0]
+                        + u * (exact[1][0] - exact[0][0])
+                        + w * (exact[2][0] - exact[0][0]);
+                    let y = exact[0][1]
+                        + u * (exact[1][1] - exact[0][1])
+                        + w * (exact[2][1] - exact[0][1]);
+                    let (got, plane) = (t.eval(x, y), linear.eval(x, y));
+                    for k in 0..4 {
+                        let want = field(x, y, k);
+                        assert!(
+                            (got[k] as f64 - want).abs() < 2e-3,
+                            "{x0} {k}: {} {want}",
+                            got[k]
+                        );
+                        off_plane = off_plane.max((plane[k] as f64 - want).abs());
+                    }
+                }
+                // The field is far from linear over the triangle: the test sees the bumps.
+                assert!(off_plane > 0.05, "{off_plane}");
             }
         }
     }
