@@ -63,7 +63,23 @@ fn inputs() -> Vec<(String, Vec<PathBuf>)> {
 #[test]
 #[ignore = "slow: run with --release -- --ignored"]
 fn fast_path_matches_reference_at_1024_on_every_file() {
-    compare_at(1024);
+    compare_at(1024, None, "");
+}
+
+/// Interpolated in the other working spaces (the sRGB ones measure colour through derivatives
+/// to Lab, linear and quadratic pieces alike).
+#[test]
+#[ignore = "slow: run with --release -- --ignored"]
+fn fast_path_matches_reference_in_other_spaces() {
+    for space in [
+        ColourSpace::Srgb,
+        ColourSpace::SrgbLinear,
+        ColourSpace::Oklab,
+    ] {
+        for name in ["Glasses.off", "irregular-vertex.json", "edge-kinds.json"] {
+            compare_at(700, Some(space), name);
+        }
+    }
 }
 
 /// Small images make the real meshes dense for their size: the fast path then starts from
@@ -71,21 +87,24 @@ fn fast_path_matches_reference_at_1024_on_every_file() {
 #[test]
 #[ignore = "slow: run with --release -- --ignored"]
 fn fast_path_matches_reference_on_dense_meshes() {
-    compare_at(160);
-    compare_at(256);
+    compare_at(160, None, "");
+    compare_at(256, None, "");
 }
 
-fn compare_at(size: u32) {
+/// Compares the files whose name contains `only` (and `GRADMESH_ONLY`, if set).
+fn compare_at(size: u32, space: Option<ColourSpace>, only: &str) {
     let mut failures = Vec::new();
     // GRADMESH_ONLY=NAME checks only the files whose name contains NAME.
-    let only = std::env::var("GRADMESH_ONLY").unwrap_or_default();
-    for (name, files) in inputs().into_iter().filter(|(n, _)| n.contains(&only)) {
+    let env_only = std::env::var("GRADMESH_ONLY").unwrap_or_default();
+    let wanted = |n: &str| n.contains(only) && n.contains(&env_only);
+    for (name, files) in inputs().into_iter().filter(|(n, _)| wanted(n)) {
         let mut doc = Document::default();
         for f in &files {
             doc.layers.extend(read_path(f).unwrap().layers);
         }
         let mut opts = RenderOptions::fit(&doc, size);
         opts.dither = false;
+        opts.colour_space_override = space;
         let fast = render_document(&doc, &opts).unwrap();
         opts.reference = true;
         let reference = render_document(&doc, &opts).unwrap();
@@ -102,6 +121,10 @@ fn compare_at(size: u32) {
             }
         }
         let mean = sum / n.max(1) as f64;
+        let name = match space {
+            Some(space) => format!("{name} in {space:?}"),
+            None => name,
+        };
         println!("{name} at {size}: {n} pixels, max {max:.3}, mean {mean:.4} CIEDE2000");
         if max > 0.5 || mean > 0.05 {
             failures.push(format!("{name} at {size}: max {max:.3}, mean {mean:.4}"));

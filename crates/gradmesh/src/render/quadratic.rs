@@ -194,6 +194,12 @@ pub(super) fn measure_cells(
         };
         let sides = [side(0), side(1), side(2), side(3)];
         let diagonal = node_at(cell[0], cell[2]);
+        // Spaces whose distances are not Lab's are measured through the derivative to Lab at
+        // the cell's centre (as the linear measure does at each sample): two conversions per
+        // test would cost more than the rest of the measure.
+        let centre = at2((cell[0].0 + cell[2].0, cell[0].1 + cell[2].1));
+        let jacobian = matches!(space, ColourSpace::Srgb | ColourSpace::SrgbLinear)
+            .then(|| space.lab_jacobian([centre[2], centre[3], centre[4]]));
         let p = each4(|k| px(corner(k)));
         let c = each4(|k| attr(corner(k)));
         let triangles = [
@@ -212,7 +218,8 @@ pub(super) fn measure_cells(
             let v = [cell[t[0]], cell[t[1]], cell[t[2]]];
             let mut check = |(i, j): (usize, usize)| {
                 let d = at4(i, j);
-                worst = worst.max(sample_error(space, attr(d), q.eval(px(d)), None));
+                let shown = q.eval(px(d));
+                worst = worst.max(sample_error(space, attr(d), shown, jacobian.as_ref()));
             };
             for e in 0..3 {
                 let (a, b, r) = (v[e], v[(e + 1) % 3], v[(e + 2) % 3]);
