@@ -189,6 +189,9 @@ pub struct RenderArgs {
     /// Do not dither 8-bit output.
     #[arg(long)]
     pub no_dither: bool,
+    /// Interpolate colour linearly over every triangle (no quadratic faces: more triangles, as before 2026-12).
+    #[arg(long)]
+    pub linear_colour: bool,
     /// Draw the outline of each mesh on top, one pixel wide.
     #[arg(long)]
     pub boundary: bool,

@@ -468,4 +468,23 @@ fn render_writes_the_image_paths_pixels() {
         let expect = encode_png(&image, bits, dither).unwrap();
         assert!(std::fs::read(&out).unwrap() == expect, "{extra:?}");
     }
+    // `--linear-colour` is the library's `quadratic: false`, and draws other pixels.
+    let mut opts = RenderOptions::new(240, height, view);
+    opts.quadratic = false;
+    let (linear, _) = render_image(&doc, &opts).unwrap();
+    let out = dir.path().join("linear.png");
+    let args = [
+        "render",
+        s(&input),
+        "-o",
+        s(&out),
+        "--width",
+        "240",
+        "--linear-colour",
+    ];
+    let o = gradmesh(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let expect = encode_png(&linear, 8, true).unwrap();
+    assert!(std::fs::read(&out).unwrap() == expect);
+    assert!(expect != encode_png(&image, 8, true).unwrap());
 }

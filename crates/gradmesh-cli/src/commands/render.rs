@@ -62,6 +62,7 @@ fn options(args: &RenderArgs, doc: &Document) -> Result<RenderOptions, Error> {
     opts.reference = args.reference;
     opts.level = args.level;
     opts.dither = !args.no_dither;
+    opts.quadratic = !args.linear_colour;
     opts.max_pixels = args.max_pixels;
     Ok(opts)
 }
