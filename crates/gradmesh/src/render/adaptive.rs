@@ -1049,20 +1049,8 @@ mod tests {
     /// (up to single precision, and to the 1/512 pixel between the exact and the snapped side).
     #[test]
     fn shared_sides_agree_in_colour() {
-        let dir = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../../shared/realdata/gradientmeshimproved-off/"
-        );
         for name in ["Glasses.off", "Tucan_Tucan_Layer2.off"] {
-            let path = std::path::PathBuf::from(dir).join(name);
-            let doc = crate::formats::read_path(&path).unwrap();
-            let opts = RenderOptions::fit(&doc, 700);
-            let (w, h) = (opts.width as i64, opts.height as i64);
-            let xf = ToPixels::new(&opts.view, opts.width, opts.height);
-            let th = Thresholds::new(&opts, ColourSpace::Lab);
-            let (mut refinement, _) = Refinement::new(&doc.layers[0], 2).unwrap();
-            let mut data = refinement.evaluate();
-            let tess = tessellate(&mut refinement, &mut data, &xf, &th, 12, (w, h)).unwrap();
+            let (_, _, tess) = real_tessellation(name);
             let tris: Vec<&Triangle> = tess.triangles.iter().collect();
             let mut sides: std::collections::HashMap<([i64; 2], [i64; 2]), Vec<usize>> =
                 std::collections::HashMap::new();
@@ -1103,6 +1091,23 @@ mod tests {
         }
     }
 
+    /// A real file's first layer, its options at 700 px, and its tessellation.
+    fn real_tessellation(name: &str) -> (crate::Document, RenderOptions, Tessellation) {
+        let dir = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../../shared/realdata/gradientmeshimproved-off/"
+        );
+        let doc = crate::formats::read_path(&std::path::PathBuf::from(dir).join(name)).unwrap();
+        let opts = RenderOptions::fit(&doc, 700);
+        let (w, h) = (opts.width as i64, opts.height as i64);
+        let xf = ToPixels::new(&opts.view, opts.width, opts.height);
+        let th = Thresholds::new(&opts, ColourSpace::Lab);
+        let (mut refinement, _) = Refinement::new(&doc.layers[0], 2).unwrap();
+        let mut data = refinement.evaluate();
+        let tess = tessellate(&mut refinement, &mut data, &xf, &th, 12, (w, h)).unwrap();
+        (doc, opts, tess)
+    }
+
     /// Pixel coverage counts of a tessellation.
     fn coverage(tess: &Tessellation, w: i64, h: i64) -> Vec<u32> {
         let mut hits = vec![0u32; (w * h) as usize];
@@ -1122,24 +1127,13 @@ mod tests {
     /// faces fanned from their centre): every pixel centre inside the outline is covered.
     #[test]
     fn real_artwork_has_no_cracks() {
-        let dir = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../../shared/realdata/gradientmeshimproved-off/"
-        );
         for name in [
             "Glasses.off",
             "Tucan_Tucan_Layer3.off",
             "Tucan_Tucan_Layer0.off",
         ] {
-            let path = std::path::PathBuf::from(dir).join(name);
-            let doc = crate::formats::read_path(&path).unwrap();
-            let opts = RenderOptions::fit(&doc, 700);
+            let (doc, opts, tess) = real_tessellation(name);
             let (w, h) = (opts.width as i64, opts.height as i64);
-            let xf = ToPixels::new(&opts.view, opts.width, opts.height);
-            let th = Thresholds::new(&opts, ColourSpace::Lab);
-            let (mut refinement, _) = Refinement::new(&doc.layers[0], 2).unwrap();
-            let mut data = refinement.evaluate();
-            let tess = tessellate(&mut refinement, &mut data, &xf, &th, 12, (w, h)).unwrap();
             let hits = coverage(&tess, w, h);
             // Inside: the pixel and its neighbours lie wholly within the outline, which is
             // drawn exactly, apart from the triangles.
