@@ -244,22 +244,24 @@ fn measure_grid(
             || (a.1 == n && b.1 == n && boundary[2])
             || (a.0 == 0 && b.0 == 0 && boundary[3])
     };
-    // Spaces whose distances are not (a multiple of) Lab's measure through the derivative at
-    // each sample: one conversion per sample instead of two per comparison. The samples are
+    // Spaces whose distances are not Lab's measure through the derivative at each sample: one conversion per sample instead of two per comparison. The samples are
     // the points of the finer grid with an odd coordinate; the others are never asked for.
-    let jacobians: Option<Vec<Matrix3>> =
-        matches!(th.space, ColourSpace::Srgb | ColourSpace::SrgbLinear).then(|| {
-            g2.iter()
-                .enumerate()
-                .map(|(k, d)| {
-                    if (k % s2) % 2 == 0 && (k / s2) % 2 == 0 {
-                        Matrix3::default()
-                    } else {
-                        th.space.lab_jacobian([d[2], d[3], d[4]])
-                    }
-                })
-                .collect()
-        });
+    let jacobians: Option<Vec<Matrix3>> = matches!(
+        th.space,
+        ColourSpace::Srgb | ColourSpace::SrgbLinear | ColourSpace::Oklab
+    )
+    .then(|| {
+        g2.iter()
+            .enumerate()
+            .map(|(k, d)| {
+                if (k % s2) % 2 == 0 && (k / s2) % 2 == 0 {
+                    Matrix3::default()
+                } else {
+                    th.space.lab_jacobian([d[2], d[3], d[4]])
+                }
+            })
+            .collect()
+    });
     let jac = |a: (usize, usize), b: (usize, usize)| {
         jacobians.as_ref().map(|j| &j[(a.1 + b.1) * s2 + a.0 + b.0])
     };

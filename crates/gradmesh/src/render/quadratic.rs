@@ -198,8 +198,11 @@ pub(super) fn measure_cells(
         // the cell's centre (as the linear measure does at each sample): two conversions per
         // test would cost more than the rest of the measure.
         let centre = at2((cell[0].0 + cell[2].0, cell[0].1 + cell[2].1));
-        let jacobian = matches!(space, ColourSpace::Srgb | ColourSpace::SrgbLinear)
-            .then(|| space.lab_jacobian([centre[2], centre[3], centre[4]]));
+        let jacobian = matches!(
+            space,
+            ColourSpace::Srgb | ColourSpace::SrgbLinear | ColourSpace::Oklab
+        )
+        .then(|| space.lab_jacobian([centre[2], centre[3], centre[4]]));
         let p = each4(|k| px(corner(k)));
         let c = each4(|k| attr(corner(k)));
         let triangles = [
