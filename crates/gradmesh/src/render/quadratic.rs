@@ -287,7 +287,7 @@ mod tests {
         let px = |k: usize| xf.apply(g[k][0], g[k][1]);
         let corners = [0, 2, 12];
         let mids = [(1, 0), (2, 1), (1, 1)];
-        let m = each3_nodes(&g, side, &xf, corners, mids);
+        let m = side_nodes(&g, side, &xf, corners, mids);
         let q = Quadratic {
             p: corners.map(px),
             c: corners.map(|k| [g[k][2], g[k][3], g[k][4], g[k][5]]),
@@ -307,7 +307,9 @@ mod tests {
         }
     }
 
-    fn each3_nodes(
+    /// The nodes of the sides of the triangle through grid points `corners` (flat indices),
+    /// from the samples at grid positions `mids` (side `k` runs from corner `k` to `k + 1`).
+    fn side_nodes(
         g: &[VertexData],
         side: usize,
         xf: &ToPixels,
