@@ -37,7 +37,7 @@ use super::layer::{measure_quad, Measure, QuadSamples, Thresholds};
 use super::nearest::Segment;
 use super::patches::{regular_corners, regular_patch_with, ControlGrid, Grid, LocalPatch};
 use super::quadratic::{chord_node, measure_cells, screen_gradient, Cell, Quadratic};
-use super::triangles::{snap, Bounds, Triangle, TriangleList};
+use super::triangles::{snap, Bounds, Triangle, TriangleList, UNBOUNDED};
 use super::view::ToPixels;
 use super::{each3, each4};
 
@@ -694,6 +694,20 @@ pub(super) fn tessellate(
     };
 
     // 3. Triangles.
+    let bounds = plans.iter().any(|p| p.order == Order::Quadratic).then(|| {
+        let mut b = [[f32::INFINITY; 4], [f32::NEG_INFINITY; 4]];
+        for p in d {
+            for k in 0..4 {
+                // Widened by a millionth: the f32 of a value may lie on either side of it.
+                let v = p[2 + k] as f32;
+                let margin = 1e-6 * (1.0 + v.abs());
+                b[0][k] = b[0][k].min(v - margin);
+                b[1][k] = b[1][k].max(v + margin);
+            }
+        }
+        b
+    });
+    let clamp_to = bounds.as_ref().unwrap_or(&UNBOUNDED);
     // Appends face `f`'s triangles to `out`.
     let face_triangles = |out: &mut Vec<Triangle>, f: usize| {
         let plan = &plans[f];
@@ -733,7 +747,7 @@ pub(super) fn tessellate(
             own_node(g2, a, b)
         };
         let mut push = |d: [&VertexData; 3], mids: Option<[[f64; 4]; 3]>| {
-            if let Some(x) = screen_triangle(d, mids, xf, size) {
+            if let Some(x) = screen_triangle(d, mids, clamp_to, xf, size) {
                 out.push(x);
             }
         };
@@ -915,19 +929,6 @@ pub(super) fn tessellate(
     }
 
     let finest = plans.iter().map(|p| p.n).max().unwrap_or(1);
-    let bounds = plans.iter().any(|p| p.order == Order::Quadratic).then(|| {
-        let mut b = [[f32::INFINITY; 4], [f32::NEG_INFINITY; 4]];
-        for p in d {
-            for k in 0..4 {
-                // Widened by a millionth: the f32 of a value may lie on either side of it.
-                let v = p[2 + k] as f32;
-                let margin = 1e-6 * (1.0 + v.abs());
-                b[0][k] = b[0][k].min(v - margin);
-                b[1][k] = b[1][k].max(v + margin);
-            }
-        }
-        b
-    });
     Some(Tessellation {
         base_level: k0,
         level: k0 + finest.trailing_zeros() as usize,
@@ -967,17 +968,18 @@ fn turn_flags(g: &[VertexData], n: usize) -> u8 {
     flags
 }
 
-/// The triangle through three limit samples, in pixels, quadratic with the side nodes `mids`,
-/// if it may cover a pixel centre of the image (see [`super::layer::screen_triangle_px`]).
+/// The triangle through three limit samples, in pixels, quadratic with the side nodes `mids`
+/// (within the colour `bounds`), if it may cover a pixel centre of the image (see [`super::layer::screen_triangle_px`]).
 fn screen_triangle(
     d: [&VertexData; 3],
     mids: Option<[[f64; 4]; 3]>,
+    bounds: &Bounds,
     xf: &ToPixels,
     size: (i64, i64),
 ) -> Option<Triangle> {
     let exact = each3(|k| xf.apply(d[k][0], d[k][1]));
     let attr = each3(|k| [d[k][2], d[k][3], d[k][4], d[k][5]]);
-    super::layer::screen_triangle_px(exact, attr, mids, size)
+    super::layer::screen_triangle_px(exact, attr, mids, bounds, size)
 }
 
 #[cfg(test)]

@@ -17,7 +17,7 @@ use super::adaptive;
 use super::coverage::Line;
 use super::nearest::{NearestSegments, Segment};
 use super::outline::{boundary_loops, outline};
-use super::triangles::{snap, Bounds, Triangle, TriangleList, SUBPIXEL};
+use super::triangles::{snap, Bounds, Triangle, TriangleList, SUBPIXEL, UNBOUNDED};
 use super::view::ToPixels;
 use super::{each3, each4, LayerInfo, LayerTimings, RenderOptions};
 
@@ -520,11 +520,13 @@ fn choose_level(
 }
 
 /// The triangle through three points (pixels) with attributes `attr` (and quadratic, with the
-/// side nodes `mids`), snapped, if it may cover a pixel centre of a `size` image.
+/// side nodes `mids`, and the layer's colour `bounds`), snapped, if it may cover a pixel centre
+/// of a `size` image.
 pub(super) fn screen_triangle_px(
     exact: [[f64; 2]; 3],
     attr: [[f64; 4]; 3],
     mids: Option<[[f64; 4]; 3]>,
+    bounds: &Bounds,
     size: (i64, i64),
 ) -> Option<Triangle> {
     let (w, h) = size;
@@ -545,7 +547,7 @@ pub(super) fn screen_triangle_px(
     if outside || no_column {
         return None;
     }
-    let tri = Triangle::new_quadratic(v, exact, attr, mids)?;
+    let tri = Triangle::new_quadratic(v, exact, attr, mids, bounds)?;
     let rows = tri.rows();
     (rows.1 > 0 && rows.0 < h && rows.0 < rows.1).then_some(tri)
 }
@@ -569,7 +571,13 @@ fn uniform_triangles(
         (1..fv.len() - 1)
             .filter_map(|i| {
                 let idx = [fv[0], fv[i], fv[i + 1]];
-                screen_triangle_px(idx.map(|i| exact[i as usize]), idx.map(attr), None, size)
+                screen_triangle_px(
+                    idx.map(|i| exact[i as usize]),
+                    idx.map(attr),
+                    None,
+                    &UNBOUNDED,
+                    size,
+                )
             })
             .collect()
     };

@@ -833,13 +833,38 @@ fn draw_band<P: OutputPixel>(
                     px[ch] = P::encode(rgba[ch], noise[ch]);
                 }
             }
-        } else {
+        } else if linear {
             for (px, c) in pixels {
                 let rgba = straight_srgb::<P>(c, linear);
                 for ch in 0..4 {
-                    px[ch] = P::encode(rgba[ch], 0.0);
+                    px[ch] = P::encode_plain(rgba[ch]);
                 }
             }
+        } else {
+            encode_row_plain(row_out, row_colour);
+        }
+    }
+}
+
+/// Encodes a row of premultiplied sRGB-encoded colour without dither. Runs of opaque pixels
+/// (most of them), whose straight colour is the colour itself, take a loop without branches,
+/// which vectorises.
+fn encode_row_plain<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]]) {
+    let mut i = 0;
+    while i < colour.len() {
+        let run = colour[i..].iter().take_while(|c| c[3] >= 1.0).count();
+        // Alpha, at least 1, encodes as 1.
+        let channels = colour[i..i + run].as_flattened();
+        for (o, &v) in out[4 * i..4 * (i + run)].iter_mut().zip(channels) {
+            *o = P::encode_plain(if P::SATURATES { v } else { v.clamp(0.0, 1.0) });
+        }
+        i += run;
+        if i < colour.len() {
+            let rgba = straight_srgb::<P>(&colour[i], false);
+            for ch in 0..4 {
+                out[4 * i + ch] = P::encode_plain(rgba[ch]);
+            }
+            i += 1;
         }
     }
 }

@@ -17,6 +17,12 @@ pub trait OutputPixel: Copy + Send + Sync + 'static {
     /// before rounding by types that dither; values exactly 0 or 1 are never dithered, so flat
     /// white, black, opaque and transparent areas stay exact.
     fn encode(v: f32, noise: f32) -> Self;
+
+    /// [`OutputPixel::encode`] without noise, bit for bit, in a form without branches that
+    /// loops over whole rows vectorise.
+    fn encode_plain(v: f32) -> Self {
+        Self::encode(v, 0.0)
+    }
 }
 
 impl OutputPixel for f32 {
@@ -51,6 +57,18 @@ impl OutputPixel for u8 {
             // the sum above -0.5), without the library call `floor` is on baseline x86-64.
             (v * 255.0 + 0.5 + noise) as u8
         }
+    }
+    #[inline(always)]
+    // `max` then `min`, not `clamp`: `clamp` keeps NaN, which must give 0.
+    #[allow(clippy::manual_clamp)]
+    fn encode_plain(v: f32) -> Self {
+        // `(v * 255.0 + 0.5) as u8`, whose saturating cast does not vectorise: the floor of
+        // `y` in 0..=255 (NaN and below 0 give 0) by rounding with 2^23, whose low byte is
+        // then the nearest integer, less one where that rounded up.
+        const ROUND: f32 = 8_388_608.0;
+        let y = (v * 255.0 + 0.5).max(0.0).min(255.0);
+        let r = y + ROUND;
+        ((r.to_bits() & 0xff) - u32::from(r - ROUND > y)) as u8
     }
 }
 
@@ -249,6 +267,30 @@ mod tests {
         }
         check::<u8>();
         check::<u16>();
+    }
+
+    #[test]
+    fn plain_encoding_is_encoding_without_noise() {
+        fn check<P: OutputPixel + PartialEq + std::fmt::Debug>() {
+            let mut values = vec![f32::NAN, f32::NEG_INFINITY, f32::INFINITY, -1.0, 2.0];
+            // Every step, just below, on and just above the rounding boundaries.
+            for k in 0..=65536 {
+                let v = k as f32 / 65536.0;
+                values.extend([v, v * (1.0 - f32::EPSILON), v * (1.0 + f32::EPSILON)]);
+            }
+            for k in 0..=255 {
+                let v = (k as f32 + 0.5) / 255.0;
+                values.extend([v, v * (1.0 - f32::EPSILON), v * (1.0 + f32::EPSILON)]);
+            }
+            for v in values {
+                let (a, b) = (P::encode_plain(v), P::encode(v, 0.0));
+                // Compared as printed, so that NaN (f32) matches NaN.
+                assert_eq!(format!("{a:?}"), format!("{b:?}"), "{v}");
+            }
+        }
+        check::<u8>();
+        check::<u16>();
+        check::<f32>();
     }
 
     #[test]

@@ -81,15 +81,43 @@ pub(crate) struct Triangle {
     qxx: [f32; 4],
     qxy: [f32; 4],
     qyy: [f32; 4],
-    /// Whether there are quadratic terms: a quadratic triangle's values are clamped to the
-    /// layer's colour bounds (it may overshoot them slightly between its nodes; a linear one
-    /// cannot).
+    /// Whether there are quadratic terms.
+    #[cfg(test)]
     quadratic: bool,
+    /// Whether the values are clamped to the layer's colour bounds: a quadratic triangle may
+    /// overshoot them slightly between its nodes (a linear one cannot), unless its Bernstein
+    /// coefficients, which bound it, lie inside.
+    clamped: bool,
 }
 
 /// Per attribute, the smallest and the largest value of a layer's colours in play: quadratic
 /// pixels are clamped to them, so that no pixel leaves the box around the control colours.
 pub(crate) type Bounds = [[f32; 4]; 2];
+
+/// Whether the quadratic triangle with corner values `attr` and side nodes `mids` stays
+/// within `bounds`: its Bernstein coefficients (the corners, and `2 m - (a + b) / 2` per side),
+/// whose hull holds it, lie inside with a margin for single-precision evaluation (a few steps
+/// of the values' size, and a small fraction of their spread, which bounds the terms).
+fn within_bounds(attr: &[[f64; 4]; 3], mids: &[[f64; 4]; 3], bounds: &Bounds) -> bool {
+    (0..4).all(|k| {
+        let coefficients: [f64; 6] = std::array::from_fn(|n| {
+            let i = n % 3;
+            let (a, b) = (attr[i][k], attr[(i + 1) % 3][k]);
+            if n < 3 {
+                a
+            } else {
+                2.0 * mids[i][k] - 0.5 * (a + b)
+            }
+        });
+        let min = coefficients.iter().fold(f64::INFINITY, |m, &c| m.min(c));
+        let max = coefficients
+            .iter()
+            .fold(f64::NEG_INFINITY, |m, &c| m.max(c));
+        let (lo, hi) = (bounds[0][k] as f64, bounds[1][k] as f64);
+        let margin = 2.5e-7 * (1.0 + lo.abs().max(hi.abs())) + 1e-4 * (max - min);
+        coefficients.iter().all(|c| c.is_finite()) && min >= lo + margin && max <= hi - margin
+    })
+}
 
 /// Bounds that clamp nothing.
 pub(crate) const UNBOUNDED: Bounds = [[f32::NEG_INFINITY; 4], [f32::INFINITY; 4]];
@@ -196,18 +224,20 @@ impl Triangle {
     /// gradient mesh turns into visible 16-bit noise.
     #[cfg(test)]
     pub fn new(v: [[i64; 2]; 3], exact: [[f64; 2]; 3], attr: [[f64; 4]; 3]) -> Option<Triangle> {
-        Self::new_quadratic(v, exact, attr, None)
+        Self::new_quadratic(v, exact, attr, None, &UNBOUNDED)
     }
 
     /// As [`Triangle::new`], and with `mids` quadratic: `mids[k]` are the attributes at the
     /// midpoint of the exact side from vertex `k` to vertex `k + 1` (the six nodes of a
     /// quadratic Lagrange triangle). Two triangles that share a side and its three nodes agree
     /// all along it.
+    /// `bounds` are the layer's colour bounds, which [`Triangle::fill_row`] is given.
     pub fn new_quadratic(
         v: [[i64; 2]; 3],
         exact: [[f64; 2]; 3],
         attr: [[f64; 4]; 3],
         mids: Option<[[f64; 4]; 3]>,
+        bounds: &Bounds,
     ) -> Option<Triangle> {
         let cross = |a: [i64; 2], b: [i64; 2], c: [i64; 2]| -> i128 {
             (b[0] - a[0]) as i128 * (c[1] - a[1]) as i128
@@ -295,7 +325,9 @@ impl Triangle {
             qxx: single(3),
             qxy: single(4),
             qyy: single(5),
+            #[cfg(test)]
             quadratic: mids.is_some(),
+            clamped: mids.is_some_and(|m| !within_bounds(&attr, &m, bounds)),
         })
     }
 
@@ -323,6 +355,7 @@ impl Triangle {
         Self::origin_of(&self.v)
     }
 
+    #[inline]
     fn origin_of(v: &[[i64; 2]; 3]) -> [f64; 2] {
         [
             v[0][0].div_euclid(SUBPIXEL) as f64,
@@ -484,7 +517,7 @@ impl Triangle {
             let dx = dx0 + n as f32;
             *out = each4(|k| row[k] + (slope[k] + self.qxx[k] * dx) * dx);
         }
-        if self.quadratic {
+        if self.clamped {
             for v in out.iter_mut() {
                 *v = each4(|k| v[k].clamp(bounds[0][k], bounds[1][k]));
             }
@@ -756,7 +789,7 @@ mod tests {
                     each4(|k| field(0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), k))
                 });
                 let v = exact.map(|q| p(q[0], q[1]));
-                let t = Triangle::new_quadratic(v, exact, attr, Some(mids)).unwrap();
+                let t = Triangle::new_quadratic(v, exact, attr, Some(mids), &UNBOUNDED).unwrap();
                 let linear = Triangle::new(v, exact, attr).unwrap();
                 let mut off_plane = 0.0f64;
                 for (u, w) in [(0.2, 0.3), (0.5, 0.25), (0.1, 0.8), (0.33, 0.33)] {
@@ -781,6 +814,64 @@ mod tests {
                 assert!(off_plane > 0.05, "{off_plane}");
             }
         }
+    }
+
+    /// A quadratic triangle is clamped to the layer's bounds unless it provably stays inside:
+    /// every pixel lies within the bounds either way, and an unclamped triangle's pixels are
+    /// its polynomial's.
+    #[test]
+    fn quadratic_triangles_stay_within_bounds() {
+        let bounds: Bounds = [
+            [0.0, -10.0, -10.0, 0.999_998],
+            [100.0, 10.0, 10.0, 1.000_002],
+        ];
+        let exact = [[3.3, 2.1], [40.9, 7.2], [12.2, 35.7]];
+        let v = exact.map(|q| p(q[0], q[1]));
+        let (mut clamped, mut free) = (0, 0);
+        // Side nodes from the mean of their ends outwards: inside, then overshooting.
+        for bulge in [0.0, 2.0, 4.0, 6.0, 9.9, 10.5, 20.0] {
+            for top in [50.0, 95.0, 99.999] {
+                let attr = [
+                    [top, 8.0, -9.0, 1.0],
+                    [20.0, -9.5, 0.0, 1.0],
+                    [top - 10.0, 0.0, 9.0, 0.999_999_999_999_999_8],
+                ];
+                let mids = [0, 1, 2].map(|i| {
+                    each4(|k| {
+                        let mean = 0.5 * (attr[i][k] + attr[(i + 1) % 3][k]);
+                        if k == 3 {
+                            mean
+                        } else {
+                            mean + [bulge, -bulge, bulge][i] * if k == 0 { 0.5 } else { 0.1 }
+                        }
+                    })
+                });
+                let t = Triangle::new_quadratic(v, exact, attr, Some(mids), &bounds).unwrap();
+                let raw = Triangle::new_quadratic(v, exact, attr, Some(mids), &UNBOUNDED).unwrap();
+                let (r0, r1) = t.rows();
+                t.for_each_span(r0..r1, 64, |j, a, b| {
+                    let n = (b - a) as usize;
+                    let (mut got, mut poly) = (vec![[0.0; 4]; n], vec![[0.0; 4]; n]);
+                    t.fill_row(j as f64 + 0.5, a as f64 + 0.5, &mut got, &bounds);
+                    raw.fill_row(j as f64 + 0.5, a as f64 + 0.5, &mut poly, &bounds);
+                    for (g, q) in got.iter().zip(&poly) {
+                        for k in 0..4 {
+                            assert!(g[k] >= bounds[0][k] && g[k] <= bounds[1][k], "{g:?}");
+                            if !t.clamped {
+                                assert_eq!(g[k], q[k]);
+                            }
+                        }
+                    }
+                });
+                if t.clamped {
+                    clamped += 1;
+                } else {
+                    free += 1;
+                }
+            }
+        }
+        // Both kinds were seen.
+        assert!(clamped > 3 && free > 3, "{clamped} {free}");
     }
 
     #[test]
