@@ -663,6 +663,8 @@ fn draw_band<P: OutputPixel>(
     // Front to back ("under"): a pixel that is already opaque is not evaluated again, and the
     // band stops once all of its pixels are.
     let mut opaque = 0usize;
+    // Whether no layer above has drawn into the band: its pixels are then all clear.
+    let mut fresh = true;
     for layer in layers.iter().rev() {
         if opaque == w * rows {
             break;
@@ -726,7 +728,7 @@ fn draw_band<P: OutputPixel>(
                         let cov = coverage[i];
                         let k = r * w + i;
                         i += 1;
-                        if cov == 0.0 || s.opaque[k] {
+                        if cov == 0.0 || (!fresh && s.opaque[k]) {
                             continue;
                         }
                         let attr = if s.covered[k] {
@@ -751,14 +753,7 @@ fn draw_band<P: OutputPixel>(
                     converter.convert(&run.colour, n, &mut run.rgb);
                     for m in 0..n {
                         let (k, alpha, rgb) = (run.pixel[m] as usize, run.alpha[m], run.rgb[m]);
-                        let dst = &mut colour[k];
-                        let weight = alpha * (1.0 - dst[3]);
-                        for c in 0..3 {
-                            dst[c] += rgb[c] * weight;
-                        }
-                        // a + (1 - a) is 1, but not always in floating point.
-                        dst[3] = if alpha >= 1.0 { 1.0 } else { dst[3] + weight };
-                        if dst[3] >= 1.0 {
+                        if under(&mut colour[k], rgb, alpha, fresh) {
                             s.opaque[k] = true;
                             opaque += 1;
                         }
@@ -770,7 +765,7 @@ fn draw_band<P: OutputPixel>(
                 for i in a..b {
                     let cov = coverage[i];
                     let k = r * w + i;
-                    if cov == 0.0 || s.opaque[k] {
+                    if cov == 0.0 || (!fresh && s.opaque[k]) {
                         continue;
                     }
                     let attr = if s.covered[k] {
@@ -791,20 +786,14 @@ fn draw_band<P: OutputPixel>(
                         opts.gamut,
                         opts.blend,
                     );
-                    let dst = &mut colour[k];
-                    let weight = alpha * (1.0 - dst[3]);
-                    for c in 0..3 {
-                        dst[c] += rgb[c] * weight;
-                    }
-                    // a + (1 - a) is 1, but not always in floating point.
-                    dst[3] = if alpha >= 1.0 { 1.0 } else { dst[3] + weight };
-                    if dst[3] >= 1.0 {
+                    if under(&mut colour[k], rgb, alpha, fresh) {
                         s.opaque[k] = true;
                         opaque += 1;
                     }
                 }
             }
         }
+        fresh = false;
     }
     if let Some(bg) = background {
         for dst in colour.iter_mut() {
@@ -867,6 +856,25 @@ fn encode_row_plain<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]]) {
             i += 1;
         }
     }
+}
+
+/// Composites `rgb` with coverage `alpha` under the premultiplied pixel `dst`, which is clear
+/// when `fresh`; whether it is now opaque.
+#[inline(always)]
+fn under(dst: &mut [f32; 4], rgb: [f32; 3], alpha: f32, fresh: bool) -> bool {
+    // a + (1 - a) is 1, but not always in floating point.
+    let cover = |a: f32| if alpha >= 1.0 { 1.0 } else { a };
+    if fresh {
+        // The sum below with a clear pixel, bit for bit, without reading it.
+        *dst = [rgb[0] * alpha, rgb[1] * alpha, rgb[2] * alpha, cover(alpha)];
+    } else {
+        let weight = alpha * (1.0 - dst[3]);
+        for c in 0..3 {
+            dst[c] += rgb[c] * weight;
+        }
+        dst[3] = cover(dst[3] + weight);
+    }
+    dst[3] >= 1.0
 }
 
 /// A premultiplied colour of the blend space as straight-alpha, sRGB-encoded channels, ready
