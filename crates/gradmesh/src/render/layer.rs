@@ -32,8 +32,15 @@ const REFERENCE_TOLERANCE_PX: f64 = 0.01;
 const REFERENCE_COLOUR_TOLERANCE: f64 = 0.002;
 /// ...counted in quads at least this wide (pixels).
 const REFERENCE_MIN_QUAD_PX: f64 = 0.1;
-/// Colour errors count in quads at least this wide (diagonal, pixels) in the fast path.
+/// Colour errors count in quads at least this wide (diagonal, pixels) in the fast path...
 const MIN_QUAD_PX: f64 = 1.0;
+/// ...and in smaller cells of the fast path's faces that hold a pixel centre, down to this
+/// size. Where the surface folds, the colour error of linear pieces only falls by about 0.6 a
+/// level (the map to the screen is singular at the crease), and without a floor one spot of
+/// Glasses.off took faces of 64 x 64 cells of 0.09 pixels (2026-12: 40k cells at 1024 px,
+/// 25k with this floor; the accuracy test's figures did not move). At 0.35 the test failed
+/// (0.54 on Glasses at 160 px), at 0.5 badly (9.2, which sheet shows at a Tucan fold).
+const ADAPTIVE_MIN_COUNTED_PX: f64 = 0.2;
 /// The fast path holds each face's measured colour error to this fraction of the tolerance: the
 /// measure samples cell and side centres only, and each face now stops right at the threshold
 /// instead of at the level the worst spot of the layer asks for (the uniform path's margin).
@@ -317,8 +324,9 @@ pub(super) fn sample_error(
 /// A quad entirely off the image counts for nothing. With `adaptive` (the fast path's faces,
 /// each with its own density), its centre and midpoints decide that too (a coarse quad may
 /// bulge into the image between its corners), and the colour error of a quad under
-/// `min_quad` still counts when the quad's box holds a pixel centre: such a quad is not
-/// refined along with larger ones elsewhere, as in a uniform level.
+/// `min_quad` still counts when the quad's box holds a pixel centre (and it is at least
+/// [`ADAPTIVE_MIN_COUNTED_PX`] across): such a quad is not refined along with larger ones
+/// elsewhere, as in a uniform level.
 pub(super) fn measure_quad(
     q: &QuadSamples,
     xf: &ToPixels,
@@ -356,7 +364,8 @@ pub(super) fn measure_quad(
         let row = (lo[1] - 0.5).ceil() <= hi[1] - 0.5;
         column && row
     };
-    let counts = extent >= min_quad || (adaptive && holds_centre());
+    let counts =
+        extent >= min_quad || (adaptive && extent >= ADAPTIVE_MIN_COUNTED_PX && holds_centre());
     // `which`: 0 for the centre, 1 + k for the midpoint of side k.
     let check = |m: &mut Measure, sample: &VertexData, which: usize, tri: usize| {
         if !counts {
