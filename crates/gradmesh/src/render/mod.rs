@@ -814,7 +814,9 @@ fn draw_band<P: OutputPixel>(
     {
         let y = (y0 + r) as u32;
         let pixels = row_out.chunks_exact_mut(4).zip(row_colour);
-        if dither {
+        if dither && !linear {
+            encode_row_dithered(row_out, row_colour, y);
+        } else if dither {
             for (x, (px, c)) in pixels.enumerate() {
                 let rgba = straight_srgb::<P>(c, linear);
                 let noise = output::dither_noise(x as u32, y);
@@ -852,6 +854,46 @@ fn encode_row_plain<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]]) {
             let rgba = straight_srgb::<P>(&colour[i], false);
             for ch in 0..4 {
                 out[4 * i + ch] = P::encode_plain(rgba[ch]);
+            }
+            i += 1;
+        }
+    }
+}
+
+/// [`encode_row_plain`] with dither noise, for row `y`. In runs of opaque pixels the hashes
+/// of a chunk come first (64-bit, one at a time), then the noise and the encoding, which
+/// vectorise.
+fn encode_row_dithered<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]], y: u32) {
+    const CHUNK: usize = 64;
+    let mut hashes = [0u64; CHUNK];
+    let mut i = 0;
+    while i < colour.len() {
+        let run = colour[i..].iter().take_while(|c| c[3] >= 1.0).count();
+        for start in (i..i + run).step_by(CHUNK) {
+            let end = (start + CHUNK).min(i + run);
+            for (x, h) in (start..end).zip(&mut hashes) {
+                *h = output::dither_hash(x as u32, y);
+            }
+            let pixels = out[4 * start..4 * end].chunks_exact_mut(4);
+            for ((px, c), &h) in pixels.zip(&colour[start..end]).zip(&hashes) {
+                let noise = output::noise_of_hash(h);
+                // Alpha, at least 1, encodes as 1.
+                for ch in 0..4 {
+                    let v = if P::SATURATES {
+                        c[ch]
+                    } else {
+                        c[ch].clamp(0.0, 1.0)
+                    };
+                    px[ch] = P::encode_branchless(v, noise[ch]);
+                }
+            }
+        }
+        i += run;
+        if i < colour.len() {
+            let rgba = straight_srgb::<P>(&colour[i], false);
+            let noise = output::dither_noise(i as u32, y);
+            for ch in 0..4 {
+                out[4 * i + ch] = P::encode(rgba[ch], noise[ch]);
             }
             i += 1;
         }

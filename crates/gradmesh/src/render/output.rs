@@ -23,6 +23,11 @@ pub trait OutputPixel: Copy + Send + Sync + 'static {
     fn encode_plain(v: f32) -> Self {
         Self::encode(v, 0.0)
     }
+
+    /// [`OutputPixel::encode`], bit for bit, in a form without branches.
+    fn encode_branchless(v: f32, noise: f32) -> Self {
+        Self::encode(v, noise)
+    }
 }
 
 impl OutputPixel for f32 {
@@ -59,17 +64,30 @@ impl OutputPixel for u8 {
         }
     }
     #[inline(always)]
-    // `max` then `min`, not `clamp`: `clamp` keeps NaN, which must give 0.
-    #[allow(clippy::manual_clamp)]
     fn encode_plain(v: f32) -> Self {
-        // `(v * 255.0 + 0.5) as u8`, whose saturating cast does not vectorise: the floor of
-        // `y` in 0..=255 (NaN and below 0 give 0) by rounding with 2^23, whose low byte is
-        // then the nearest integer, less one where that rounded up.
-        const ROUND: f32 = 8_388_608.0;
-        let y = (v * 255.0 + 0.5).max(0.0).min(255.0);
-        let r = y + ROUND;
-        ((r.to_bits() & 0xff) - u32::from(r - ROUND > y)) as u8
+        // `(v * 255.0 + 0.5) as u8`, whose saturating cast does not vectorise.
+        floor_to_u8(v * 255.0 + 0.5)
     }
+    #[inline(always)]
+    fn encode_branchless(v: f32, noise: f32) -> Self {
+        // The extremes chosen by selects, not branches.
+        let y = v * 255.0 + 0.5 + noise;
+        let y = if v <= 0.0 { 0.0 } else { y };
+        floor_to_u8(if v >= 1.0 { 255.0 } else { y })
+    }
+}
+
+/// `y as u8` (the floor of `y`, 0 below 0 and for NaN, 255 above 255) without the saturating
+/// cast, which does not vectorise: rounding with 2^23 leaves the nearest integer in the low
+/// byte, less one where that rounded up.
+#[inline(always)]
+// `max` then `min`, not `clamp`: `clamp` keeps NaN, which must give 0.
+#[allow(clippy::manual_clamp)]
+fn floor_to_u8(y: f32) -> u8 {
+    const ROUND: f32 = 8_388_608.0;
+    let y = y.max(0.0).min(255.0);
+    let r = y + ROUND;
+    ((r.to_bits() & 0xff) - u32::from(r - ROUND > y)) as u8
 }
 
 /// Deterministic triangular (TPDF) dither noise in `-1..1` for the four channels of pixel
@@ -79,11 +97,22 @@ impl OutputPixel for u8 {
 /// (eight bytes of noise at 1/256 of an output step are plenty).
 #[inline(always)]
 pub(crate) fn dither_noise(x: u32, y: u32) -> [f32; 4] {
-    // splitmix64's finaliser of the position.
+    noise_of_hash(dither_hash(x, y))
+}
+
+/// The hash of pixel `(x, y)` that [`dither_noise`] is made of: splitmix64's finaliser of the
+/// position.
+#[inline(always)]
+pub(crate) fn dither_hash(x: u32, y: u32) -> u64 {
     let mut v = ((y as u64) << 32 | x as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
     v = (v ^ (v >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     v = (v ^ (v >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    v ^= v >> 31;
+    v ^ (v >> 31)
+}
+
+/// [`dither_noise`] from the pixel's [`dither_hash`].
+#[inline(always)]
+pub(crate) fn noise_of_hash(v: u64) -> [f32; 4] {
     let b = v.to_le_bytes();
     // Written out: `[_; 4].map` with a closure was left as a call per pixel.
     let tpdf = |lo: u8, hi: u8| (lo as f32 + hi as f32 + 1.0) / 256.0 - 1.0;
@@ -286,6 +315,31 @@ mod tests {
                 let (a, b) = (P::encode_plain(v), P::encode(v, 0.0));
                 // Compared as printed, so that NaN (f32) matches NaN.
                 assert_eq!(format!("{a:?}"), format!("{b:?}"), "{v}");
+            }
+        }
+        check::<u8>();
+        check::<u16>();
+        check::<f32>();
+    }
+
+    #[test]
+    fn branchless_encoding_is_encoding() {
+        fn check<P: OutputPixel + PartialEq + std::fmt::Debug>() {
+            let mut values = vec![f32::NAN, f32::NEG_INFINITY, f32::INFINITY, -1.0, 2.0];
+            for k in 0..=4096 {
+                let v = k as f32 / 4096.0;
+                values.extend([v, v * (1.0 - f32::EPSILON), v * (1.0 + f32::EPSILON)]);
+            }
+            for k in 0..=255 {
+                let v = (k as f32 + 0.5) / 255.0;
+                values.extend([v, v * (1.0 - f32::EPSILON), v * (1.0 + f32::EPSILON)]);
+            }
+            let noises = [-0.999_999, -0.5, -1.0 / 256.0, 0.0, 0.25, 0.5, 0.999_999];
+            for v in values {
+                for noise in noises {
+                    let (a, b) = (P::encode_branchless(v, noise), P::encode(v, noise));
+                    assert_eq!(format!("{a:?}"), format!("{b:?}"), "{v} {noise}");
+                }
             }
         }
         check::<u8>();
