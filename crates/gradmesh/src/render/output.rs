@@ -298,20 +298,22 @@ mod tests {
         check::<u16>();
     }
 
+    /// Values for checking encodings: the extremes and NaN, `steps + 1` even steps from 0 to 1,
+    /// and the 8-bit rounding boundaries, each also just below and just above.
+    fn encoding_test_values(steps: u32) -> Vec<f32> {
+        let mut values = vec![f32::NAN, f32::NEG_INFINITY, f32::INFINITY, -1.0, 2.0];
+        let steps = (0..=steps).map(|k| k as f32 / steps as f32);
+        let boundaries = (0..=255).map(|k| (k as f32 + 0.5) / 255.0);
+        for v in steps.chain(boundaries) {
+            values.extend([v, v * (1.0 - f32::EPSILON), v * (1.0 + f32::EPSILON)]);
+        }
+        values
+    }
+
     #[test]
     fn plain_encoding_is_encoding_without_noise() {
         fn check<P: OutputPixel + PartialEq + std::fmt::Debug>() {
-            let mut values = vec![f32::NAN, f32::NEG_INFINITY, f32::INFINITY, -1.0, 2.0];
-            // Every step, just below, on and just above the rounding boundaries.
-            for k in 0..=65536 {
-                let v = k as f32 / 65536.0;
-                values.extend([v, v * (1.0 - f32::EPSILON), v * (1.0 + f32::EPSILON)]);
-            }
-            for k in 0..=255 {
-                let v = (k as f32 + 0.5) / 255.0;
-                values.extend([v, v * (1.0 - f32::EPSILON), v * (1.0 + f32::EPSILON)]);
-            }
-            for v in values {
+            for v in encoding_test_values(65536) {
                 let (a, b) = (P::encode_plain(v), P::encode(v, 0.0));
                 // Compared as printed, so that NaN (f32) matches NaN.
                 assert_eq!(format!("{a:?}"), format!("{b:?}"), "{v}");
@@ -325,17 +327,8 @@ mod tests {
     #[test]
     fn branchless_encoding_is_encoding() {
         fn check<P: OutputPixel + PartialEq + std::fmt::Debug>() {
-            let mut values = vec![f32::NAN, f32::NEG_INFINITY, f32::INFINITY, -1.0, 2.0];
-            for k in 0..=4096 {
-                let v = k as f32 / 4096.0;
-                values.extend([v, v * (1.0 - f32::EPSILON), v * (1.0 + f32::EPSILON)]);
-            }
-            for k in 0..=255 {
-                let v = (k as f32 + 0.5) / 255.0;
-                values.extend([v, v * (1.0 - f32::EPSILON), v * (1.0 + f32::EPSILON)]);
-            }
             let noises = [-0.999_999, -0.5, -1.0 / 256.0, 0.0, 0.25, 0.5, 0.999_999];
-            for v in values {
+            for v in encoding_test_values(4096) {
                 for noise in noises {
                     let (a, b) = (P::encode_branchless(v, noise), P::encode(v, noise));
                     assert_eq!(format!("{a:?}"), format!("{b:?}"), "{v} {noise}");
