@@ -104,6 +104,7 @@ mod quadratic;
 mod triangles;
 mod view;
 
+use std::ops::Range;
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
@@ -837,25 +838,38 @@ fn draw_band<P: OutputPixel>(
     }
 }
 
-/// Encodes a row of premultiplied sRGB-encoded colour without dither. Runs of opaque pixels
-/// (most of them), whose straight colour is the colour itself, take a loop without branches,
-/// which vectorises.
-fn encode_row_plain<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]]) {
+/// The runs of opaque pixels of a row of premultiplied colour (their straight colour is the
+/// colour itself), each with the index of the pixel after it, if that is not opaque. Runs may
+/// be empty.
+#[inline]
+fn opaque_runs(colour: &[[f32; 4]]) -> impl Iterator<Item = (Range<usize>, Option<usize>)> + '_ {
     let mut i = 0;
-    while i < colour.len() {
-        let run = colour[i..].iter().take_while(|c| c[3] >= 1.0).count();
+    std::iter::from_fn(move || {
+        if i >= colour.len() {
+            return None;
+        }
+        let start = i;
+        let end = start + colour[start..].iter().take_while(|c| c[3] >= 1.0).count();
+        let other = (end < colour.len()).then_some(end);
+        i = end + usize::from(other.is_some());
+        Some((start..end, other))
+    })
+}
+
+/// Encodes a row of premultiplied sRGB-encoded colour without dither. Runs of opaque pixels
+/// (most of them) take a loop without branches, which vectorises.
+fn encode_row_plain<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]]) {
+    for (run, other) in opaque_runs(colour) {
         // Alpha, at least 1, encodes as 1.
-        let channels = colour[i..i + run].as_flattened();
-        for (o, &v) in out[4 * i..4 * (i + run)].iter_mut().zip(channels) {
+        let channels = colour[run.clone()].as_flattened();
+        for (o, &v) in out[4 * run.start..4 * run.end].iter_mut().zip(channels) {
             *o = P::encode_plain(if P::SATURATES { v } else { v.clamp(0.0, 1.0) });
         }
-        i += run;
-        if i < colour.len() {
+        if let Some(i) = other {
             let rgba = straight_srgb::<P>(&colour[i], false);
             for ch in 0..4 {
                 out[4 * i + ch] = P::encode_plain(rgba[ch]);
             }
-            i += 1;
         }
     }
 }
@@ -866,11 +880,9 @@ fn encode_row_plain<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]]) {
 fn encode_row_dithered<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]], y: u32) {
     const CHUNK: usize = 64;
     let mut hashes = [0u64; CHUNK];
-    let mut i = 0;
-    while i < colour.len() {
-        let run = colour[i..].iter().take_while(|c| c[3] >= 1.0).count();
-        for start in (i..i + run).step_by(CHUNK) {
-            let end = (start + CHUNK).min(i + run);
+    for (run, other) in opaque_runs(colour) {
+        for start in run.clone().step_by(CHUNK) {
+            let end = (start + CHUNK).min(run.end);
             for (x, h) in (start..end).zip(&mut hashes) {
                 *h = output::dither_hash(x as u32, y);
             }
@@ -888,14 +900,12 @@ fn encode_row_dithered<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]], y: u3
                 }
             }
         }
-        i += run;
-        if i < colour.len() {
+        if let Some(i) = other {
             let rgba = straight_srgb::<P>(&colour[i], false);
             let noise = output::dither_noise(i as u32, y);
             for ch in 0..4 {
                 out[4 * i + ch] = P::encode(rgba[ch], noise[ch]);
             }
-            i += 1;
         }
     }
 }
