@@ -538,6 +538,17 @@ pub(super) fn screen_triangle_px(
     bounds: &Bounds,
     size: (i64, i64),
 ) -> Option<Triangle> {
+    let v = snapped_if_visible(exact, size)?;
+    let tri = Triangle::new_quadratic(v, exact, attr, mids, bounds)?;
+    let rows = tri.rows();
+    (rows.1 > 0 && rows.0 < size.1 && rows.0 < rows.1).then_some(tri)
+}
+
+/// The snapped corners of the triangle through three points (pixels), unless it surely covers
+/// no pixel centre of a `size` image: it lies beside the image, or no column of pixel centres
+/// runs between its leftmost and rightmost corner (at deep levels most cells are under a
+/// pixel). Cheap enough to ask before finding a triangle's attributes.
+pub(super) fn snapped_if_visible(exact: [[f64; 2]; 3], size: (i64, i64)) -> Option<[[i64; 2]; 3]> {
     let (w, h) = size;
     let (xmax, ymax) = (w * SUBPIXEL, h * SUBPIXEL);
     let snapped = |p: [f64; 2]| Some([snap(p[0])?, snap(p[1])?]);
@@ -546,19 +557,12 @@ pub(super) fn screen_triangle_px(
         || v.iter().all(|p| p[0] > xmax)
         || v.iter().all(|p| p[1] < 0)
         || v.iter().all(|p| p[1] > ymax);
-    // No pixel centre column between the leftmost and rightmost vertex: nothing to draw
-    // (at deep levels most quads are under a pixel).
     let half = SUBPIXEL / 2;
     let left = v.iter().map(|p| p[0]).min().expect("three vertices");
     let right = v.iter().map(|p| p[0]).max().expect("three vertices");
     let no_column = (left - half).div_euclid(SUBPIXEL) == (right - half).div_euclid(SUBPIXEL)
         && (left - half).rem_euclid(SUBPIXEL) != 0;
-    if outside || no_column {
-        return None;
-    }
-    let tri = Triangle::new_quadratic(v, exact, attr, mids, bounds)?;
-    let rows = tri.rows();
-    (rows.1 > 0 && rows.0 < h && rows.0 < rows.1).then_some(tri)
+    (!outside && !no_column).then_some(v)
 }
 
 /// The uniform path's triangles: every quad of level `t` with the limit data `lim` at its
