@@ -676,7 +676,12 @@ fn draw_band<P: OutputPixel>(
             continue;
         }
         let (c0, c1) = layer.columns;
-        let converter = gamut::RunConverter::new(layer.space, opts.gamut, opts.blend);
+        let shading = Shading {
+            space: layer.space,
+            converter: gamut::RunConverter::new(layer.space, opts.gamut, opts.blend),
+            gamut: opts.gamut,
+            blend: opts.blend,
+        };
         let bounds = layer.bounds.as_ref().unwrap_or(&triangles::UNBOUNDED);
         // Outline colours of a layer with quadratic sides are clamped as its triangles are.
         let nearest = |p: [f64; 2]| {
@@ -718,81 +723,21 @@ fn draw_band<P: OutputPixel>(
             let coverage = &s.coverage[..c1];
             let b = b.min(c1);
             let y = (y0 + r) as f64 + 0.5;
-            if layer.space == ColourSpace::Lab {
-                // In runs: first the pixels this layer shows, then their colours all at once
-                // (vectorised), then compositing.
-                let mut i = a;
-                while i < b {
-                    let run = &mut s.run;
-                    let mut n = 0;
-                    while i < b && n < RUN {
-                        let cov = coverage[i];
-                        let k = r * w + i;
-                        i += 1;
-                        if cov == 0.0 || (!fresh && s.opaque[k]) {
-                            continue;
-                        }
-                        let attr = if s.covered[k] {
-                            s.attributes[k]
-                        } else {
-                            match nearest([(i - 1) as f64 + 0.5, y]) {
-                                Some(a) => a,
-                                None => continue,
-                            }
-                        };
-                        let alpha = cov * attr[3].clamp(0.0, 1.0);
-                        if alpha <= 0.0 {
-                            continue;
-                        }
-                        for c in 0..3 {
-                            run.colour[c][n] = attr[c];
-                        }
-                        run.alpha[n] = alpha;
-                        run.pixel[n] = k as u32;
-                        n += 1;
-                    }
-                    converter.convert(&run.colour, n, &mut run.rgb);
-                    for m in 0..n {
-                        let (k, alpha, rgb) = (run.pixel[m] as usize, run.alpha[m], run.rgb[m]);
-                        if under(&mut colour[k], rgb, alpha, fresh) {
-                            s.opaque[k] = true;
-                            opaque += 1;
-                        }
-                    }
-                }
+            let band = BandPixels {
+                row: r * w,
+                opaque: &mut s.opaque,
+                covered: &s.covered,
+                attributes: &s.attributes,
+                run: &mut s.run,
+                colour,
+            };
+            // Separate loops for the first layer, which has nothing to test and nothing to
+            // read: the tests cost the `vs_cairo` scene a tenth of its drawing instructions.
+            opaque += if fresh {
+                shade_row::<true>(a..b, coverage, y, band, &nearest, &shading)
             } else {
-                // Pixel by pixel: the other spaces have no vector path, and gathering them
-                // into runs cost the sRGB `vs_cairo` scene 4 % more instructions.
-                for i in a..b {
-                    let cov = coverage[i];
-                    let k = r * w + i;
-                    if cov == 0.0 || (!fresh && s.opaque[k]) {
-                        continue;
-                    }
-                    let attr = if s.covered[k] {
-                        s.attributes[k]
-                    } else {
-                        match nearest([i as f64 + 0.5, y]) {
-                            Some(a) => a,
-                            None => continue,
-                        }
-                    };
-                    let alpha = cov * attr[3].clamp(0.0, 1.0);
-                    if alpha <= 0.0 {
-                        continue;
-                    }
-                    let rgb = gamut::to_blend_space_f32(
-                        layer.space,
-                        [attr[0], attr[1], attr[2]],
-                        opts.gamut,
-                        opts.blend,
-                    );
-                    if under(&mut colour[k], rgb, alpha, fresh) {
-                        s.opaque[k] = true;
-                        opaque += 1;
-                    }
-                }
-            }
+                shade_row::<false>(a..b, coverage, y, band, &nearest, &shading)
+            };
         }
         fresh = false;
     }
@@ -908,6 +853,103 @@ fn encode_row_dithered<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]], y: u3
             }
         }
     }
+}
+
+/// How one layer's attributes become colours of the blend space.
+struct Shading {
+    space: ColourSpace,
+    converter: gamut::RunConverter,
+    gamut: GamutMapping,
+    blend: BlendSpace,
+}
+
+/// One row of a band's buffers, as a layer shades it.
+struct BandPixels<'a> {
+    /// The index of the row's first pixel in the band.
+    row: usize,
+    opaque: &'a mut [bool],
+    covered: &'a [bool],
+    attributes: &'a [[f32; 4]],
+    run: &'a mut Run,
+    colour: &'a mut [[f32; 4]],
+}
+
+/// Composites a layer under the band's colour in columns `cols` of one row, whose coverage is
+/// `coverage` (indexed by column): the attributes its triangles filled in, or else the nearest
+/// outline's (the sliver between the tessellation and the outline). `FRESH`: no layer has drawn
+/// into the band yet. Returns how many pixels became opaque.
+#[inline(always)]
+fn shade_row<const FRESH: bool>(
+    cols: Range<usize>,
+    coverage: &[f32],
+    y: f64,
+    band: BandPixels<'_>,
+    nearest: &impl Fn([f64; 2]) -> Option<[f32; 4]>,
+    shading: &Shading,
+) -> usize {
+    let BandPixels {
+        row,
+        opaque,
+        covered,
+        attributes,
+        run,
+        colour,
+    } = band;
+    let mut made_opaque = 0;
+    let mut put = |k: usize, rgb: [f32; 3], alpha: f32, opaque: &mut [bool]| {
+        if under(&mut colour[k], rgb, alpha, FRESH) {
+            opaque[k] = true;
+            made_opaque += 1;
+        }
+    };
+    // The pixel's attributes and opacity, unless the layer leaves it alone.
+    let shown = |i: usize, opaque: &[bool]| -> Option<([f32; 4], f32)> {
+        let (cov, k) = (coverage[i], row + i);
+        if cov == 0.0 || (!FRESH && opaque[k]) {
+            return None;
+        }
+        let attr = if covered[k] {
+            attributes[k]
+        } else {
+            nearest([i as f64 + 0.5, y])?
+        };
+        let alpha = cov * attr[3].clamp(0.0, 1.0);
+        (alpha > 0.0).then_some((attr, alpha))
+    };
+    if shading.space == ColourSpace::Lab {
+        // In runs: first the pixels this layer shows, then their colours all at once
+        // (vectorised), then compositing.
+        let mut i = cols.start;
+        while i < cols.end {
+            let mut n = 0;
+            while i < cols.end && n < RUN {
+                if let Some((attr, alpha)) = shown(i, opaque) {
+                    for c in 0..3 {
+                        run.colour[c][n] = attr[c];
+                    }
+                    run.alpha[n] = alpha;
+                    run.pixel[n] = (row + i) as u32;
+                    n += 1;
+                }
+                i += 1;
+            }
+            shading.converter.convert(&run.colour, n, &mut run.rgb);
+            for m in 0..n {
+                put(run.pixel[m] as usize, run.rgb[m], run.alpha[m], opaque);
+            }
+        }
+    } else {
+        // Pixel by pixel: the other spaces have no vector path, and gathering them into runs
+        // cost the sRGB `vs_cairo` scene 4 % more instructions.
+        for i in cols {
+            if let Some((attr, alpha)) = shown(i, opaque) {
+                let c = [attr[0], attr[1], attr[2]];
+                let rgb = gamut::to_blend_space_f32(shading.space, c, shading.gamut, shading.blend);
+                put(row + i, rgb, alpha, opaque);
+            }
+        }
+    }
+    made_opaque
 }
 
 /// Composites `rgb` with coverage `alpha` under the premultiplied pixel `dst`, which is clear
