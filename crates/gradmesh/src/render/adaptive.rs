@@ -61,6 +61,11 @@ const MIN_BASE_FACE_PIXELS: usize = 64;
 /// linear).
 const QUADRATIC_MAX_LINEAR_ERROR: f64 = 8.0;
 
+/// The slowest that linear pieces' colour error is taken to fall per level for a face that
+/// does not fold but may border one: where the surface folds, about 0.6 was seen (see
+/// `MIN_COUNTED_PX`'s notes in `docs/performance.md`), elsewhere it quarters.
+const LINEAR_RATE_NEAR_FOLDS: f64 = 0.6;
+
 /// The base level for a layer drawn into `size` pixels: [`BASE_LEVEL`], or 2 when its faces
 /// would be too many for the image, or 1 (when the ternary step made only quads) when even
 /// level 2's would.
@@ -313,6 +318,8 @@ struct Plan {
     order: Order,
     /// A quadratic face's grid of `2 n` cells a side: its midpoint nodes.
     finer: Option<Grid>,
+    /// A quadratic face's colour error with linear pieces, where measured at its count.
+    linear_colour: Option<f64>,
 }
 
 /// Tessellates the layer adaptively, or `None` where the fast path does not apply (a face
@@ -386,6 +393,7 @@ pub(super) fn tessellate(
             centre: None,
             order: Order::Linear,
             finer: None,
+            linear_colour: None,
         };
         if off_image {
             return Some(plan);
@@ -443,6 +451,7 @@ pub(super) fn tessellate(
                 if passes(&mq) {
                     plan.measured = mq;
                     plan.order = Order::Quadratic;
+                    plan.linear_colour = Some(m.colour);
                     if plan.n == 1 {
                         plan.centre = Some(finer[4]);
                     }
@@ -546,8 +555,24 @@ pub(super) fn tessellate(
             if n != plan.n {
                 let mut src = Source::new(level, &regular, d, f)?;
                 plan.grid = src.grid(n)?;
-                if plan.order == Order::Quadratic {
-                    plan.finer = Some(src.grid(2 * n)?);
+                // A quadratic face refined further for its neighbours' sake is often fine
+                // enough for linear pieces, which need no grid of twice the count for their
+                // nodes: predicted from the linear error at its own count, falling by no
+                // more than LINEAR_RATE_NEAR_FOLDS a level.
+                let levels = (n / plan.n).trailing_zeros() as i32;
+                let linear = plan
+                    .linear_colour
+                    .map(|c| c * LINEAR_RATE_NEAR_FOLDS.powi(levels))
+                    .filter(|&c| c <= th.colour);
+                match (plan.order, linear) {
+                    (Order::Quadratic, Some(colour)) => {
+                        plan.order = Order::Linear;
+                        plan.finer = None;
+                        plan.measured.colour = colour;
+                        plan.estimated = true;
+                    }
+                    (Order::Quadratic, None) => plan.finer = Some(src.grid(2 * n)?),
+                    (Order::Linear, _) => {}
                 }
                 plan.n = n;
             }
