@@ -9,7 +9,7 @@
 use kurbo::{Point, Vec2};
 
 use crate::catmull_clark::Level;
-use crate::topology::{Topology, INVALID};
+use crate::topology::{Topology, INVALID, PARALLEL_MIN_CORNERS};
 use crate::validate::{BaseMesh, VertexData};
 
 /// Index of the vertex point of base vertex `v`.
@@ -280,8 +280,13 @@ pub fn ternary_topology(t: &Topology) -> Topology {
             ring_edges,
         )
     };
+    // A level 1 of nine times the corners: concurrently where that pays (see `subdivide`).
     let ((face_offsets, face_verts, face_edges), ((edge_verts, edge_faces), rings)) =
-        rayon::join(faces, || rayon::join(edges, rings));
+        if 9 * nc < PARALLEL_MIN_CORNERS {
+            (faces(), (edges(), rings()))
+        } else {
+            rayon::join(faces, || rayon::join(edges, rings))
+        };
     let (ring_offsets, ring_faces, ring_corners, edge_ring_offsets, ring_edges) = rings;
 
     Topology {

@@ -8,6 +8,9 @@ use crate::error::ErrorKind;
 /// Marks a missing face or edge.
 pub const INVALID: u32 = u32::MAX;
 
+/// Meshes with fewer corners than this are subdivided on one thread.
+pub(crate) const PARALLEL_MIN_CORNERS: usize = 1 << 12;
+
 /// The connectivity of a polygon mesh with boundaries.
 #[derive(Clone, Debug, Default)]
 pub struct Topology {
@@ -530,8 +533,14 @@ impl Topology {
                 ring_edges,
             )
         };
+        // Concurrently where it pays: a small mesh (a face's neighbourhood, refined locally)
+        // is built in less time than handing its parts to other threads takes.
         let ((face_offsets, face_verts, face_edges), ((edge_verts, edge_faces), rings)) =
-            rayon::join(faces, || rayon::join(edges, rings));
+            if nc < PARALLEL_MIN_CORNERS {
+                (faces(), (edges(), rings()))
+            } else {
+                rayon::join(faces, || rayon::join(edges, rings))
+            };
         let (ring_offsets, ring_faces, ring_corners, edge_ring_offsets, ring_edges) = rings;
 
         Topology {
