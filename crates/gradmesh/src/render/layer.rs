@@ -547,7 +547,7 @@ pub(super) fn screen_triangle_px(
 /// The snapped corners of the triangle through three points (pixels), unless it surely covers
 /// no pixel centre of a `size` image: it lies beside the image, or no column of pixel centres
 /// runs between its leftmost and rightmost corner (at deep levels most cells are under a
-/// pixel). Cheap enough to ask before finding a triangle's attributes.
+/// pixel).
 pub(super) fn snapped_if_visible(exact: [[f64; 2]; 3], size: (i64, i64)) -> Option<[[i64; 2]; 3]> {
     let (w, h) = size;
     let (xmax, ymax) = (w * SUBPIXEL, h * SUBPIXEL);
