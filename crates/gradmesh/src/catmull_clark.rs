@@ -311,6 +311,17 @@ fn vertex_mask_terms(
 /// edge point of the incoming edge]`, wound like its parent.
 pub fn refine(parent: &Level) -> (Level, Stencils) {
     let t = &parent.topology;
+    let child = refine_level(parent);
+    let stencils = Stencils::build(
+        t.face_count() + t.edge_count() + t.vertex_count(),
+        stencil_terms(parent),
+    );
+    (child, stencils)
+}
+
+/// The child level of `parent`, as [`refine`] gives it, without the stencils.
+pub fn refine_level(parent: &Level) -> Level {
+    let t = &parent.topology;
     let (nf, ne, nv) = (t.face_count(), t.edge_count(), t.vertex_count());
     let vertex_point = |v: u32| (nf + ne + v as usize) as u32;
 
@@ -337,15 +348,33 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
                 parent.half_edge_sharpness(fe[(i + n - 1) % n], fv[i]);
         }
     }
-    let child = Level {
+    Level {
         topology: child_topology,
         edge_sharpness: child_edge_sharpness,
         vertex_sharpness: child_vertex_sharpness,
         creasing: parent.creasing,
-    };
+    }
+}
 
-    let stencils = Stencils::build(nf + ne + nv, stencil_terms(parent));
-    (child, stencils)
+/// Writes the data of the child vertices `vertices` of `parent` into `out` (indexed by child
+/// vertex; the others are left alone), bit for bit as [`refine`]'s stencils give it. For a
+/// face refined locally, whose next depth keeps a few of the child's faces.
+pub fn refine_data_at(
+    parent: &Level,
+    data: &[VertexData],
+    vertices: &[u32],
+    out: &mut [VertexData],
+) {
+    let terms = stencil_terms(parent);
+    let mut stencils = Stencils::with_capacity(vertices.len(), 10 * vertices.len());
+    let mut buffer = Vec::with_capacity(64);
+    for &v in vertices {
+        terms(v as usize, &mut buffer);
+        stencils.push(&mut buffer);
+    }
+    for (&v, value) in vertices.iter().zip(stencils.apply(data)) {
+        out[v as usize] = value;
+    }
 }
 
 /// The data of the child of `parent`: equal to `refine(parent).1.apply(data)`, bit for bit,

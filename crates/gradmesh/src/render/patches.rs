@@ -461,12 +461,25 @@ impl LocalPatch {
         let Some((last_level, last_data)) = &last.local else {
             return Some(());
         };
-        let (child, stencils) = catmull_clark::refine(last_level);
-        let child_data = stencils.apply(last_data);
+        let child = catmull_clark::refine_level(last_level);
         let mut tiles = Vec::with_capacity(4 * last.tiles.len());
         for tile in &last.tiles {
             tiles.extend(tile.children(last_level.topology.face_offset(tile.face as usize)));
         }
+        // Data only for the vertices of the faces around the children, where their patches'
+        // control points and the next depth's neighbourhood lie: about half of the child's.
+        let ct = &child.topology;
+        let mut wanted = vec![false; ct.vertex_count()];
+        for f in neighbourhood(ct, &tiles) {
+            for &v in ct.face_vertices(f as usize) {
+                wanted[v as usize] = true;
+            }
+        }
+        let wanted: Vec<u32> = (0..ct.vertex_count() as u32)
+            .filter(|&v| wanted[v as usize])
+            .collect();
+        let mut child_data = vec![[0.0; 6]; ct.vertex_count()];
+        catmull_clark::refine_data_at(last_level, last_data, &wanted, &mut child_data);
         let mut patches = Vec::new();
         tiles.retain(|tile| {
             let face = tile.face as usize;
