@@ -113,7 +113,12 @@ pub(super) struct Tessellation {
 #[allow(clippy::large_enum_variant)]
 enum Source {
     Regular(ControlGrid),
-    Local(LocalPatch),
+    /// Face `root` of a local refinement: of the face alone, or of the faces around an
+    /// extraordinary vertex refined together.
+    Local {
+        patch: LocalPatch,
+        root: usize,
+    },
 }
 
 impl Source {
@@ -121,19 +126,29 @@ impl Source {
     fn new(level: &Level, regular: &[bool], data: &[VertexData], f: usize) -> Option<Source> {
         match regular_patch_with(level, data, f, |v| regular[v]) {
             Some(cp) => Some(Source::Regular(cp)),
-            None => LocalPatch::new(level, data, f).map(Source::Local),
+            None => {
+                LocalPatch::new(level, data, &[f]).map(|patch| Source::Local { patch, root: 0 })
+            }
         }
     }
 
     fn grid(&mut self, n: usize) -> Option<Grid> {
         match self {
             Source::Regular(cp) => Some(super::patches::evaluate_patch(cp, n)),
-            Source::Local(p) => p.grid(n),
+            Source::Local { patch, root } => patch.grid(*root, n),
         }
     }
 
-    /// Whether the convex hull of the points the surface is made of misses the image.
-    fn off_image(&self, xf: &ToPixels, size: (f64, f64)) -> bool {
+    /// Whether the convex hull of the points face `f`'s surface is made of misses the image:
+    /// a patch's control points, or the points of the faces around it in `level`.
+    fn off_image(
+        &self,
+        level: &Level,
+        data: &[VertexData],
+        f: usize,
+        xf: &ToPixels,
+        size: (f64, f64),
+    ) -> bool {
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         let mut grow = |d: &VertexData| {
             let p = xf.apply(d[0], d[1]);
@@ -144,7 +159,16 @@ impl Source {
         };
         match self {
             Source::Regular(cp) => cp.iter().flatten().for_each(&mut grow),
-            Source::Local(p) => p.control_points().iter().for_each(&mut grow),
+            Source::Local { .. } => {
+                let t = &level.topology;
+                for &v in t.face_vertices(f) {
+                    for &g in t.vertex_faces(v as usize) {
+                        for &w in t.face_vertices(g as usize) {
+                            grow(&data[w as usize]);
+                        }
+                    }
+                }
+            }
         }
         hi[0] < -1.0 || hi[1] < -1.0 || lo[0] > size.0 + 1.0 || lo[1] > size.1 + 1.0
     }
@@ -369,9 +393,8 @@ pub(super) fn tessellate(
 
     // 1. The density of each face.
     let orders = CellOrders::new(n_max.max(1) * 2);
-    let plan_face = |f: usize| -> Option<Plan> {
-        let mut src = Source::new(level, &regular, d, f)?;
-        let off_image = src.off_image(xf, th.size);
+    let plan_face = |f: usize, src: &mut Source| -> Option<Plan> {
+        let off_image = src.off_image(level, d, f, xf, th.size);
         // A regular patch's grid of two cells holds its grid of one (the same parameters and
         // arithmetic): evaluate it once and take its corners. (Local refinement evaluates each
         // depth on its own, so it keeps its order of evaluation.)
@@ -503,10 +526,63 @@ pub(super) fn tessellate(
             }
         }
     };
-    let mut plans: Vec<Plan> = (0..nf)
+    // Regular faces first, each on its own.
+    let mut plans: Vec<Option<Plan>> = (0..nf)
         .into_par_iter()
-        .map(plan_face)
+        .map(|f| match regular_patch_with(level, d, f, |v| regular[v]) {
+            Some(cp) => plan_face(f, &mut Source::Regular(cp)).map(Some),
+            None => Some(None),
+        })
         .collect::<Option<_>>()?;
+    // The others refine locally, grouped by their first corner that is not regular (for
+    // most, the extraordinary vertex they surround): a group shares one local refinement.
+    let mut irregular: Vec<(usize, usize)> = (0..nf)
+        .filter(|&f| plans[f].is_none())
+        .map(|f| {
+            let corner = t.face_vertices(f).iter().find(|&&v| !regular[v as usize]);
+            (corner.map_or(t.vertex_count() + f, |&v| v as usize), f)
+        })
+        .collect();
+    irregular.sort_unstable();
+    let groups: Vec<&[(usize, usize)]> = irregular.chunk_by(|a, b| a.0 == b.0).collect();
+    let each_alone = |group: &[(usize, usize)]| -> Option<Vec<(usize, Plan)>> {
+        group
+            .iter()
+            .map(|&(_, f)| plan_face(f, &mut Source::new(level, &regular, d, f)?).map(|p| (f, p)))
+            .collect()
+    };
+    let together = |group: &[(usize, usize)]| -> Option<Vec<(usize, Plan)>> {
+        let faces: Vec<usize> = group.iter().map(|&(_, f)| f).collect();
+        let mut src = Source::Local {
+            patch: LocalPatch::new(level, d, &faces)?,
+            root: 0,
+        };
+        let mut planned = Vec::with_capacity(faces.len());
+        for (k, &f) in faces.iter().enumerate() {
+            if let Source::Local { root, .. } = &mut src {
+                *root = k;
+            }
+            planned.push((f, plan_face(f, &mut src)?));
+        }
+        Some(planned)
+    };
+    let planned: Vec<Vec<(usize, Plan)>> = groups
+        .par_iter()
+        .map(|&group| {
+            // Neighbourhoods that do not form a valid mesh together may do so one by one.
+            (group.len() > 1)
+                .then(|| together(group))
+                .flatten()
+                .or_else(|| each_alone(group))
+        })
+        .collect::<Option<_>>()?;
+    for (f, plan) in planned.into_iter().flatten() {
+        plans[f] = Some(plan);
+    }
+    let mut plans: Vec<Plan> = plans
+        .into_iter()
+        .map(|p| p.expect("every face is planned"))
+        .collect();
     // 2. Counts per edge: the finer face's. A face is first refined to at least half of its
     // finest edge (2:1 balance with the faces' own densities: the faces around a deeply
     // refined spot, often a fold near a singular point, follow its shape closely). A coarser

@@ -264,12 +264,14 @@ pub(crate) fn regular_patch_with(
     Some(cp)
 }
 
-/// One quad of a locally refined face at some depth: its index in that level, and where its
-/// corners 0, 1, 2, 3 sit in the face's grid of `2^depth` cells a side (origin, step from
-/// corner 0 to 1, step from corner 0 to 3).
+/// One quad of a locally refined face at some depth: its index in that level, the face it
+/// descends from (its index among the faces refined together), and where its corners 0, 1, 2,
+/// 3 sit in that face's grid of `2^depth` cells a side (origin, step from corner 0 to 1, step
+/// from corner 0 to 3).
 #[derive(Clone, Copy, Debug)]
 struct Tile {
     face: u32,
+    root: u32,
     origin: [i64; 2],
     u: [i64; 2],
     v: [i64; 2],
@@ -293,6 +295,7 @@ impl Tile {
             let towards = |q: [i64; 2]| [(q[0] - p[0]) / 2, (q[1] - p[1]) / 2];
             Tile {
                 face: (first + c) as u32,
+                root: self.root,
                 origin: p,
                 u: towards(corners[(c + 1) % 4]),
                 v: towards(corners[(c + 3) % 4]),
@@ -305,18 +308,25 @@ impl Tile {
 struct LocalLevel {
     /// The faces around `tiles`, as their own mesh (`None` when no tile is left).
     local: Option<(Level, Vec<VertexData>)>,
-    /// The face's descendants at this depth that are refined further.
+    /// The faces' descendants at this depth that are refined further.
     tiles: Vec<Tile>,
-    /// Its descendants at this depth whose limit surface is a B-spline patch: evaluated
+    /// Their descendants at this depth whose limit surface is a B-spline patch: evaluated
     /// directly, never refined.
     patches: Vec<(Tile, ControlGrid)>,
+    /// The limit points of the corners of `tiles`, once asked for: a slot per vertex of
+    /// `local` (`u32::MAX` for none) and the points.
+    corner_limits: Option<(Vec<u32>, Vec<VertexData>)>,
 }
 
-/// A face refined on its own, feature-adaptively: at each depth the descendants that have
+/// Faces refined on their own, feature-adaptively: at each depth the descendants that have
 /// become regular patches are set aside, and only the faces around the others (which
 /// determine their limit surface) are refined further. Next to an extraordinary vertex one
 /// descendant a depth stays irregular, along a crease a row of them, so the work per depth
 /// stays nearly constant instead of growing fourfold.
+///
+/// The faces around one extraordinary vertex refine overlapping neighbourhoods: refined
+/// together, they share the work (their neighbourhoods together are about three faces', not
+/// one per face).
 pub(crate) struct LocalPatch {
     levels: Vec<LocalLevel>,
 }
@@ -417,41 +427,38 @@ fn neighbourhood(t: &Topology, tiles: &[Tile]) -> Vec<u32> {
 }
 
 impl LocalPatch {
-    /// Extracts the neighbourhood of face `f` of `level`; `None` if it is not a quad or the
-    /// neighbourhood does not form a valid mesh on its own.
-    pub fn new(level: &Level, data: &[VertexData], f: usize) -> Option<LocalPatch> {
-        if level.topology.face_vertices(f).len() != 4 {
+    /// Extracts the neighbourhood of the faces `faces` of `level` (their roots are their
+    /// indices in `faces`); `None` if one is not a quad or the neighbourhood does not form a
+    /// valid mesh on its own.
+    pub fn new(level: &Level, data: &[VertexData], faces: &[usize]) -> Option<LocalPatch> {
+        let t = &level.topology;
+        if faces.iter().any(|&f| t.face_vertices(f).len() != 4) {
             return None;
         }
-        let whole = Tile {
-            face: f as u32,
-            origin: [0, 0],
-            u: [1, 0],
-            v: [0, 1],
-        };
-        let keep = neighbourhood(&level.topology, &[whole]);
+        let mut tiles: Vec<Tile> = faces
+            .iter()
+            .enumerate()
+            .map(|(root, &f)| Tile {
+                face: f as u32,
+                root: root as u32,
+                origin: [0, 0],
+                u: [1, 0],
+                v: [0, 1],
+            })
+            .collect();
+        let keep = neighbourhood(t, &tiles);
         let (local, local_data) = extract(level, data, &keep)?;
-        let tiles = vec![Tile {
-            face: local_face(&keep, f as u32),
-            ..whole
-        }];
+        for tile in &mut tiles {
+            tile.face = local_face(&keep, tile.face);
+        }
         Some(LocalPatch {
             levels: vec![LocalLevel {
                 local: Some((local, local_data)),
                 tiles,
                 patches: Vec::new(),
+                corner_limits: None,
             }],
         })
-    }
-
-    /// The data of the neighbourhood's points: the face's limit surface lies in their convex
-    /// hull.
-    pub fn control_points(&self) -> &[VertexData] {
-        &self.levels[0]
-            .local
-            .as_ref()
-            .expect("depth 0 has the face")
-            .1
     }
 
     /// Refines the last depth once: children that are regular patches are set aside, and the
@@ -505,24 +512,26 @@ impl LocalPatch {
             local,
             tiles,
             patches,
+            corner_limits: None,
         });
         Some(())
     }
 
-    /// The limit surface over the face on a grid of `n x n` cells (`n` a power of two): the
-    /// patches set aside down to depth `log2 n` on their share of the grid, and the corners of
-    /// the descendants still refined at that depth at their limit positions.
-    pub fn grid(&mut self, n: usize) -> Option<Grid> {
+    /// The limit surface over face `root` on a grid of `n x n` cells (`n` a power of two):
+    /// the patches set aside down to depth `log2 n` on their share of the grid, and the
+    /// corners of the descendants still refined at that depth at their limit positions.
+    pub fn grid(&mut self, root: usize, n: usize) -> Option<Grid> {
         let depth = n.trailing_zeros() as usize;
         while self.levels.len() <= depth && !self.levels.last().expect("depth 0").tiles.is_empty() {
             self.deepen()?;
         }
+        let root = root as u32;
         let stride = n as i64 + 1;
         let mut grid = vec![[0.0; 6]; (n + 1) * (n + 1)];
         for (d, at) in self.levels.iter().enumerate().take(depth + 1) {
             // A tile of depth `d` spans `m` cells of the grid.
             let m = 1i64 << (depth - d);
-            for (tile, cp) in &at.patches {
+            for (tile, cp) in at.patches.iter().filter(|(tile, _)| tile.root == root) {
                 let o = [tile.origin[0] * m, tile.origin[1] * m];
                 evaluate_patch_with(cp, m as usize, |i, j, p| {
                     let (i, j) = (i as i64, j as i64);
@@ -535,26 +544,31 @@ impl LocalPatch {
         let Some(LocalLevel {
             local: Some((level, data)),
             tiles,
+            corner_limits,
             ..
-        }) = self.levels.get(depth)
+        }) = self.levels.get_mut(depth)
         else {
             return Some(grid);
         };
         let t = &level.topology;
-        // The limit points of the tiles' corners only (the ring around them is most of the
-        // local level), each once.
-        let mut slot = vec![u32::MAX; t.vertex_count()];
-        let mut wanted = Vec::with_capacity(4 * tiles.len());
-        for tile in tiles {
-            for &v in t.face_vertices(tile.face as usize) {
-                if slot[v as usize] == u32::MAX {
-                    slot[v as usize] = wanted.len() as u32;
-                    wanted.push(v);
+        if corner_limits.is_none() {
+            // The limit points of the tiles' corners only (the ring around them is most of
+            // the local level), each once, for every face refined together.
+            let mut slot = vec![u32::MAX; t.vertex_count()];
+            let mut wanted = Vec::with_capacity(4 * tiles.len());
+            for tile in tiles.iter() {
+                for &v in t.face_vertices(tile.face as usize) {
+                    if slot[v as usize] == u32::MAX {
+                        slot[v as usize] = wanted.len() as u32;
+                        wanted.push(v);
+                    }
                 }
             }
+            let limits = limit::limit_stencils_for(level, &wanted)?.apply(data);
+            *corner_limits = Some((slot, limits));
         }
-        let limits = limit::limit_stencils_for(level, &wanted)?.apply(data);
-        for tile in tiles {
+        let (slot, limits) = corner_limits.as_ref().expect("just computed");
+        for tile in tiles.iter().filter(|tile| tile.root == root) {
             let o = tile.origin;
             let corners = [
                 o,
@@ -674,8 +688,8 @@ mod tests {
         // Local refinement of face 0 (an irregular face) equals refining the whole mesh: two
         // levels down.
         assert!(t.face_vertices(0).contains(&centre));
-        let mut local = LocalPatch::new(&level, &data, 0).unwrap();
-        let g = local.grid(4).unwrap();
+        let mut local = LocalPatch::new(&level, &data, &[0]).unwrap();
+        let g = local.grid(0, 4).unwrap();
         let (l1, s1) = refine(&level);
         let (l2, s2) = refine(&l1);
         let d2 = s2.apply(&s1.apply(&data));
@@ -694,9 +708,9 @@ mod tests {
             .find(|&f| regular_patch(&level, &data, f).is_some())
             .expect("a regular face");
         let cp = regular_patch(&level, &data, regular).unwrap();
-        let a = LocalPatch::new(&level, &data, regular)
+        let a = LocalPatch::new(&level, &data, &[regular])
             .unwrap()
-            .grid(4)
+            .grid(0, 4)
             .unwrap();
         let b = evaluate_patch(&cp, 4);
         for (p, q) in a.iter().zip(&b) {
@@ -710,6 +724,7 @@ mod tests {
         let (mut level, mut data) = (level.clone(), data.to_vec());
         let mut tiles = vec![Tile {
             face: f as u32,
+            root: 0,
             origin: [0, 0],
             u: [1, 0],
             v: [0, 1],
@@ -748,10 +763,10 @@ mod tests {
     /// Checks face `f`'s local grids of 1 to 16 cells against the whole mesh's, and returns
     /// how many patches its local refinement set aside.
     fn check_local_grids(level: &Level, data: &[VertexData], f: usize) -> usize {
-        let mut local = LocalPatch::new(level, data, f).unwrap();
+        let mut local = LocalPatch::new(level, data, &[f]).unwrap();
         for n in [1, 2, 4, 8, 16, 4] {
             let expected = whole_mesh_grid(level, data, f, n);
-            let got = local.grid(n).unwrap();
+            let got = local.grid(0, n).unwrap();
             for (k, (a, b)) in got.iter().zip(&expected).enumerate() {
                 assert!(
                     close(*a, *b),
@@ -811,6 +826,39 @@ mod tests {
             }
         }
         assert!(set_aside > 0);
+    }
+
+    #[test]
+    fn faces_refined_together_match_the_whole_mesh() {
+        // The five faces around a valence-5 vertex, asked for in any order and at any count.
+        let (level, data) = star_level();
+        let t = &level.topology;
+        let centre = (0..t.vertex_count())
+            .find(|&v| t.vertex_edges(v).len() == 5)
+            .unwrap() as u32;
+        let around: Vec<usize> = (0..t.face_count())
+            .filter(|&f| t.face_vertices(f).contains(&centre))
+            .collect();
+        let mut group = LocalPatch::new(&level, &data, &around).unwrap();
+        for (root, n) in [
+            (0, 1),
+            (2, 4),
+            (1, 2),
+            (4, 16),
+            (3, 8),
+            (4, 1),
+            (0, 16),
+            (2, 2),
+        ] {
+            let expected = whole_mesh_grid(&level, &data, around[root], n);
+            let got = group.grid(root, n).unwrap();
+            for (k, (a, b)) in got.iter().zip(&expected).enumerate() {
+                assert!(
+                    close(*a, *b),
+                    "root {root}, n = {n}, sample {k}: {a:?} vs {b:?}"
+                );
+            }
+        }
     }
 
     /// Level 2 of a five-quad star subdivided twice: a valence-5 vertex (0) in an all-quad mesh
