@@ -867,7 +867,7 @@ pub(super) fn tessellate(
             if refined.iter().all(Option::is_none) {
                 let q = each4(|k| sample(cell[k]));
                 // Most cells of a dense face cover no pixel centre: skip their nodes.
-                if between_pixel_columns(q.map(px)) {
+                if between_pixel_centres(q.map(px)) {
                     continue;
                 }
                 match g2 {
@@ -1076,28 +1076,30 @@ fn turn_flags(g: &[VertexData], n: usize) -> u8 {
     flags
 }
 
-/// Whether points (pixels) surely lie between two adjacent columns of pixel centres, so that
-/// no triangle through them covers a centre. Cheap, and sure: the margin covers the snapping
-/// that the exact test (in [`super::layer::screen_triangle_px`]) works on.
-fn between_pixel_columns<const N: usize>(p: [[f64; 2]; N]) -> bool {
+/// Whether points (pixels) surely lie between two adjacent columns, or two adjacent rows, of
+/// pixel centres, so that no triangle through them covers a centre. Cheap, and sure: the
+/// margin covers the snapping that the exact test (in [`super::layer::screen_triangle_px`])
+/// works on.
+fn between_pixel_centres<const N: usize>(p: [[f64; 2]; N]) -> bool {
     // A sixty-fourth of a pixel: far more than the snapping moves a point.
     const MARGIN: f64 = 1.0 / 64.0;
-    let (lo, hi) = p
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
-            (lo.min(q[0]), hi.max(q[0]))
-        });
-    let (lo, hi) = (lo - 0.5 - MARGIN, hi - 0.5 + MARGIN);
-    // Far outside i64 (or NaN) they are not between; the exact test decides.
-    if !(lo.abs() < 1e15 && hi.abs() < 1e15) {
-        return false;
-    }
-    // Floors without the library call; no integer (centre) in [lo, hi].
+    // Floors without the library call.
     let floor = |v: f64| {
         let t = v as i64;
         t - i64::from(v < t as f64)
     };
-    floor(lo) == floor(hi) && (floor(lo) as f64) < lo
+    let between = |axis: usize| {
+        let (lo, hi) = p
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
+                (lo.min(q[axis]), hi.max(q[axis]))
+            });
+        let (lo, hi) = (lo - 0.5 - MARGIN, hi - 0.5 + MARGIN);
+        // Far outside i64 (or NaN) they are not between; the exact test decides. Else: no
+        // integer (centre) in [lo, hi].
+        lo.abs() < 1e15 && hi.abs() < 1e15 && floor(lo) == floor(hi) && (floor(lo) as f64) < lo
+    };
+    between(0) || between(1)
 }
 
 /// The triangle through three limit samples, in pixels, quadratic with the side nodes `mids`
@@ -1122,35 +1124,39 @@ mod tests {
     use kurbo::Point;
 
     /// The cheap test skips only cells whose triangles the exact one (on snapped corners)
-    /// culls too, also for corners a snapping step from a column of pixel centres; and it does
-    /// skip cells between two columns.
+    /// culls too, also for corners a snapping step from a column or a row of pixel centres;
+    /// and it does skip cells between two columns or two rows.
     #[test]
-    fn cells_skipped_between_pixel_columns_are_culled() {
+    fn cells_skipped_between_pixel_centres_are_culled() {
         let step = 1.0 / 256.0;
         let mut skipped = 0;
         for base in [0.0, 7.0, -3.0, 1023.0] {
-            // Corners from a third of a step left of a column to past the next one.
+            // Corners from a third of a step before a column (row) to past the next one.
             for a in -1..=780 {
                 for width in [0, 1, 2, 3, 5, 8, 40, 200] {
                     let x0 = base + 0.5 + f64::from(a) * step / 3.0;
                     let xs = [x0, x0 + f64::from(width) * step / 2.0, x0 + 0.3 * step];
-                    let quad = [[xs[0], 1.0], [xs[1], 2.0], [xs[2], 8.0], [xs[0], 9.0]];
-                    if !between_pixel_columns(quad) {
-                        continue;
-                    }
-                    skipped += 1;
-                    for tri in [[0, 1, 2], [0, 2, 3]] {
-                        let corners = tri.map(|k| quad[k]);
-                        let size = (2048, 2048);
-                        assert!(
-                            crate::render::layer::snapped_if_visible(corners, size).is_none(),
-                            "{corners:?} was skipped but may cover a pixel centre"
-                        );
+                    let tall = [[xs[0], 1.0], [xs[1], 2.0], [xs[2], 8.0], [xs[0], 9.0]];
+                    // The same cell on its side: between two rows.
+                    let wide = tall.map(|[x, y]| [y, x]);
+                    for quad in [tall, wide] {
+                        if !between_pixel_centres(quad) {
+                            continue;
+                        }
+                        skipped += 1;
+                        for tri in [[0, 1, 2], [0, 2, 3]] {
+                            let corners = tri.map(|k| quad[k]);
+                            let size = (2048, 2048);
+                            assert!(
+                                crate::render::layer::snapped_if_visible(corners, size).is_none(),
+                                "{corners:?} was skipped but may cover a pixel centre"
+                            );
+                        }
                     }
                 }
             }
         }
-        assert!(skipped > 1000, "only {skipped} cells skipped");
+        assert!(skipped > 2000, "only {skipped} cells skipped");
     }
 
     /// A flat grid whose colour has one sharp spot: the faces around it are refined deeply and

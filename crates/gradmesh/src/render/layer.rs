@@ -546,8 +546,8 @@ pub(super) fn screen_triangle_px(
 
 /// The snapped corners of the triangle through three points (pixels), unless it surely covers
 /// no pixel centre of a `size` image: it lies beside the image, or no column of pixel centres
-/// runs between its leftmost and rightmost corner (at deep levels most cells are under a
-/// pixel).
+/// runs between its leftmost and rightmost corner, or no row between its lowest and highest
+/// (at deep levels most cells are under a pixel).
 pub(super) fn snapped_if_visible(exact: [[f64; 2]; 3], size: (i64, i64)) -> Option<[[i64; 2]; 3]> {
     let (w, h) = size;
     let (xmax, ymax) = (w * SUBPIXEL, h * SUBPIXEL);
@@ -557,12 +557,16 @@ pub(super) fn snapped_if_visible(exact: [[f64; 2]; 3], size: (i64, i64)) -> Opti
         || v.iter().all(|p| p[0] > xmax)
         || v.iter().all(|p| p[1] < 0)
         || v.iter().all(|p| p[1] > ymax);
+    // No column (row) of pixel centres runs between the least and the greatest x (y): the
+    // row test is the triangle's own (`Triangle::rows`), made before building it.
     let half = SUBPIXEL / 2;
-    let left = v.iter().map(|p| p[0]).min().expect("three vertices");
-    let right = v.iter().map(|p| p[0]).max().expect("three vertices");
-    let no_column = (left - half).div_euclid(SUBPIXEL) == (right - half).div_euclid(SUBPIXEL)
-        && (left - half).rem_euclid(SUBPIXEL) != 0;
-    (!outside && !no_column).then_some(v)
+    let none_between = |axis: usize| {
+        let lo = v.iter().map(|p| p[axis]).min().expect("three vertices");
+        let hi = v.iter().map(|p| p[axis]).max().expect("three vertices");
+        (lo - half).div_euclid(SUBPIXEL) == (hi - half).div_euclid(SUBPIXEL)
+            && (lo - half).rem_euclid(SUBPIXEL) != 0
+    };
+    (!outside && !none_between(0) && !none_between(1)).then_some(v)
 }
 
 /// The uniform path's triangles: every quad of level `t` with the limit data `lim` at its
