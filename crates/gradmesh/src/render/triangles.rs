@@ -389,7 +389,7 @@ impl Triangle {
 
     /// Calls `f(j, start, end)` with the columns inside for each row `j` in `rows`, finding
     /// the edges once.
-    #[inline]
+    #[inline(always)]
     pub fn for_each_span(
         &self,
         rows: std::ops::Range<i64>,
@@ -411,6 +411,9 @@ impl Triangle {
     /// A row's span in 64-bit integers: exact when the vertices lie within [`SMALL`] and
     /// the row within [`SMALL_ROWS`] (every product stays under 2^55), and several times faster
     /// than 128-bit division. Same arithmetic, same answers.
+    // Always inlined, as are the other functions of the drawing loop: they are then compiled
+    // with the wide vector instructions of `render::wide_vectors` where the CPU has them.
+    #[inline(always)]
     fn span_small(edges: &[Edge; 3], j: i64, width: i64) -> (i64, i64) {
         let half = SUBPIXEL / 2;
         let ry = j * SUBPIXEL + half;
@@ -498,7 +501,7 @@ impl Triangle {
     /// multiply-adds per attribute and pixel, in single precision. On a linear triangle the
     /// quadratic terms are zero and the values are the plane's, bit for bit; a quadratic one's
     /// are clamped to `bounds`.
-    #[inline]
+    #[inline(always)]
     pub fn fill_row<'a>(
         &self,
         y: f64,
