@@ -781,13 +781,7 @@ mod tests {
     fn local_refinement_sets_regular_descendants_aside_without_changing_the_surface() {
         // Around a valence-5 vertex.
         let (level, data) = star_level();
-        let t = &level.topology;
-        let centre = (0..t.vertex_count())
-            .find(|&v| t.vertex_edges(v).len() == 5)
-            .unwrap() as u32;
-        let around: Vec<usize> = (0..t.face_count())
-            .filter(|&f| t.face_vertices(f).contains(&centre))
-            .collect();
+        let around = faces_around_valence_5(&level);
         assert_eq!(around.len(), 5);
         for &f in &around {
             let set_aside = check_local_grids(&level, &data, f);
@@ -832,13 +826,7 @@ mod tests {
     fn faces_refined_together_match_the_whole_mesh() {
         // The five faces around a valence-5 vertex, asked for in any order and at any count.
         let (level, data) = star_level();
-        let t = &level.topology;
-        let centre = (0..t.vertex_count())
-            .find(|&v| t.vertex_edges(v).len() == 5)
-            .unwrap() as u32;
-        let around: Vec<usize> = (0..t.face_count())
-            .filter(|&f| t.face_vertices(f).contains(&centre))
-            .collect();
+        let around = faces_around_valence_5(&level);
         let mut group = LocalPatch::new(&level, &data, &around).unwrap();
         for (root, n) in [
             (0, 1),
@@ -859,6 +847,17 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The faces of `level` around its vertex of valence 5.
+    fn faces_around_valence_5(level: &Level) -> Vec<usize> {
+        let t = &level.topology;
+        let centre = (0..t.vertex_count())
+            .find(|&v| t.vertex_edges(v).len() == 5)
+            .unwrap() as u32;
+        (0..t.face_count())
+            .filter(|&f| t.face_vertices(f).contains(&centre))
+            .collect()
     }
 
     /// Level 2 of a five-quad star subdivided twice: a valence-5 vertex (0) in an all-quad mesh
