@@ -66,11 +66,11 @@ const QUADRATIC_MAX_LINEAR_ERROR: f64 = 8.0;
 /// on counted cell sizes, seventh round of `docs/performance.md`); elsewhere it quarters.
 const LINEAR_RATE_NEAR_FOLDS: f64 = 0.6;
 
-/// The base level for a layer drawn into `size` pixels: [`BASE_LEVEL`], or 2 when its faces
-/// would be too many for the image, or 1 (when the ternary step made only quads) when even
-/// level 2's would.
-fn base_level(refinement: &Refinement, size: (i64, i64)) -> usize {
-    let pixels = (size.0.max(0) as usize).saturating_mul(size.1.max(0) as usize);
+/// The base level for a layer that can cover `pixels` pixels ([`covered_pixels`]):
+/// [`BASE_LEVEL`], or 2 when its faces would be too many for them, or 1 (when the ternary step
+/// made only quads) when even level 2's would. A layer drawn small in a large picture (one
+/// part of the artwork) starts as shallow as it would alone at its size.
+fn base_level(refinement: &Refinement, pixels: usize) -> usize {
     // Each n-gon of level 1 makes n quads of level 2 (which need not be built to count them),
     // and level 3 has four times as many.
     let faces2 = refinement.topology(1).corner_count();
@@ -82,6 +82,21 @@ fn base_level(refinement: &Refinement, size: (i64, i64)) -> usize {
     } else {
         BASE_LEVEL
     }
+}
+
+/// The pixels of a `size` image inside the box around `points` (whose convex hull holds the
+/// layer's limit surface): what a layer can cover.
+fn covered_pixels(points: &[VertexData], xf: &ToPixels, size: (i64, i64)) -> usize {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for d in points {
+        let p = xf.apply(d[0], d[1]);
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let side = |k: usize, n: i64| (hi[k].min(n as f64) - lo[k].max(0.0)).max(0.0);
+    (side(0, size.0) * side(1, size.1)) as usize
 }
 
 /// What the fast path produced for one layer.
@@ -360,7 +375,14 @@ pub(super) fn tessellate(
 ) -> Option<Tessellation> {
     // Faces refine on their own from the base level with bare stencils: it must lie below the
     // rings of the deepest multi-resolution edit.
-    let mut k0 = base_level(refinement, size).max(refinement.base().edits.deepest_level() + 1);
+    while data.levels.len() <= 1 {
+        let j = data.levels.len() - 1;
+        refinement.extend_to(j + 1);
+        let next = refinement.next_level_data(j, &data.levels[j]);
+        data.levels.push(next);
+    }
+    let pixels = covered_pixels(&data.levels[1], xf, size);
+    let mut k0 = base_level(refinement, pixels).max(refinement.base().edits.deepest_level() + 1);
     loop {
         while data.levels.len() <= k0 {
             let j = data.levels.len() - 1;
@@ -1122,6 +1144,19 @@ mod tests {
     use crate::render::{RenderOptions, View};
     use crate::GradientMesh;
     use kurbo::Point;
+
+    /// What a layer can cover: the box around its points, clipped to the image.
+    #[test]
+    fn covered_pixels_are_the_points_box_clipped_to_the_image() {
+        let xf = ToPixels::new(&View::new(0.0, 0.0, 100.0, 50.0), 100, 50);
+        let at = |x: f64, y: f64| [x, y, 50.0, 0.0, 0.0, 1.0];
+        let inside = [at(10.0, 5.0), at(30.0, 25.0), at(20.0, 10.0)];
+        assert_eq!(covered_pixels(&inside, &xf, (100, 50)), 400);
+        let across = [at(-10.0, -10.0), at(20.0, 10.0)];
+        assert_eq!(covered_pixels(&across, &xf, (100, 50)), 200);
+        let beyond = [at(-10.0, 60.0), at(300.0, 70.0)];
+        assert_eq!(covered_pixels(&beyond, &xf, (100, 50)), 0);
+    }
 
     /// The cheap test skips only cells whose triangles the exact one (on snapped corners)
     /// culls too, also for corners a snapping step from a column or a row of pixel centres;
