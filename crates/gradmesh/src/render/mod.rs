@@ -534,7 +534,14 @@ fn render<P: OutputPixel>(
         .enumerate()
         .for_each(|(band, chunk)| {
             Scratch::with(w, |scratch| {
-                draw_band_dispatched(band, chunk, &layers, opts, background, scratch)
+                let job = Band {
+                    index: band,
+                    out: chunk,
+                    layers: &layers,
+                    opts,
+                    background,
+                };
+                draw_band_dispatched(job, scratch)
             });
         });
     info.timings.draw = start.elapsed();
@@ -629,34 +636,20 @@ struct Run {
 /// [`draw_band`] compiled for the x86-64-v3 level (AVX2, FMA, BMI) where the CPU has it, else
 /// for the baseline: the same code, with the same results bit for bit (Rust never fuses a
 /// multiply and an add on its own). The wider vectors take a sixth off drawing a large image.
-fn draw_band_dispatched<P: OutputPixel>(
-    band: usize,
-    out: &mut [P],
-    layers: &[&PreparedLayer],
-    opts: &RenderOptions,
-    background: Option<[f32; 4]>,
-    s: &mut Scratch,
-) {
+fn draw_band_dispatched<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
     #[cfg(target_arch = "x86_64")]
     if wide_vectors::available() {
-        return wide_vectors::draw_band(band, out, layers, opts, background, s);
+        return wide_vectors::draw_band(job, s);
     }
-    draw_band_baseline(band, out, layers, opts, background, s)
+    draw_band_baseline(job, s)
 }
 
 /// [`draw_band`] for the baseline CPU.
 // Not inlined into the rayon closure: inlined there, its loops were compiled worse (7 % more
 // instructions for the `vs_cairo` scene, seen with callgrind).
 #[inline(never)]
-fn draw_band_baseline<P: OutputPixel>(
-    band: usize,
-    out: &mut [P],
-    layers: &[&PreparedLayer],
-    opts: &RenderOptions,
-    background: Option<[f32; 4]>,
-    s: &mut Scratch,
-) {
-    draw_band(band, out, layers, opts, background, s)
+fn draw_band_baseline<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
+    draw_band(job, s)
 }
 
 /// The one place with `unsafe` code: calling [`draw_band`] compiled for x86-64-v3, which is
@@ -664,9 +657,7 @@ fn draw_band_baseline<P: OutputPixel>(
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
 mod wide_vectors {
-    use super::{
-        draw_band as draw_band_inlined, OutputPixel, PreparedLayer, RenderOptions, Scratch,
-    };
+    use super::{draw_band as draw_band_inlined, Band, OutputPixel, Scratch};
 
     /// Whether the CPU has every feature [`draw_band_v3`] is compiled for (detected once, then
     /// read from a cache). Tests can turn the wide path off to compare the two.
@@ -687,47 +678,42 @@ mod wide_vectors {
     pub static BASELINE_ONLY: std::sync::atomic::AtomicBool =
         std::sync::atomic::AtomicBool::new(false);
 
-    pub fn draw_band<P: OutputPixel>(
-        band: usize,
-        out: &mut [P],
-        layers: &[&PreparedLayer],
-        opts: &RenderOptions,
-        background: Option<[f32; 4]>,
-        s: &mut Scratch,
-    ) {
+    pub fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
         assert!(available(), "the CPU lacks x86-64-v3");
         // SAFETY: `draw_band_v3` only needs the CPU to have the features it is compiled for,
         // and the assertion above checked that it has them.
-        unsafe { draw_band_v3(band, out, layers, opts, background, s) }
+        unsafe { draw_band_v3(job, s) }
     }
 
     /// # Safety
     /// The CPU must have the features named below ([`available`]).
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
     #[inline(never)]
-    unsafe fn draw_band_v3<P: OutputPixel>(
-        band: usize,
-        out: &mut [P],
-        layers: &[&PreparedLayer],
-        opts: &RenderOptions,
-        background: Option<[f32; 4]>,
-        s: &mut Scratch,
-    ) {
-        draw_band_inlined(band, out, layers, opts, background, s)
+    unsafe fn draw_band_v3<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
+        draw_band_inlined(job, s)
     }
 }
 
-/// Draws rows `band * BAND ..` of every layer into `out`. Inlined into the two compilations of
+/// One band of the image to draw: rows `index * BAND ..`, whose pixels are `out`.
+struct Band<'a, P> {
+    index: usize,
+    out: &'a mut [P],
+    layers: &'a [&'a PreparedLayer],
+    opts: &'a RenderOptions,
+    background: Option<[f32; 4]>,
+}
+
+/// Draws every layer into a band. Inlined into the two compilations of
 /// [`draw_band_dispatched`], with the hot functions it calls.
 #[inline(always)]
-fn draw_band<P: OutputPixel>(
-    band: usize,
-    out: &mut [P],
-    layers: &[&PreparedLayer],
-    opts: &RenderOptions,
-    background: Option<[f32; 4]>,
-    s: &mut Scratch,
-) {
+fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
+    let Band {
+        index: band,
+        out,
+        layers,
+        opts,
+        background,
+    } = job;
     let w = opts.width as usize;
     let y0 = band * BAND;
     let rows = out.len() / (4 * w);
