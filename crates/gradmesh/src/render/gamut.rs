@@ -222,12 +222,15 @@ impl RunConverter {
         }
         for m in 0..n {
             let l = [lin[0][m], lin[1][m], lin[2][m]];
-            out[m] = if in_unit(&l) {
-                linear_to_blend_space_f32(self.table, l, self.blend)
+            if in_unit(&l) {
+                // Each channel stored on its own: a colour returned through a temporary was
+                // copied out with a load wider than its stores, which stalled every pixel.
+                let encoded = linear_to_blend_space_f32(self.table, l, self.blend);
+                out[m].copy_from_slice(&encoded);
             } else {
                 let colour = [c[0][m], c[1][m], c[2][m]];
-                to_blend_space_wide(self.space, colour, self.gamut, self.blend)
-            };
+                out[m] = to_blend_space_wide(self.space, colour, self.gamut, self.blend);
+            }
         }
     }
 }
