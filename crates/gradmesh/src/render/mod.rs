@@ -859,80 +859,104 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
     }
 }
 
-/// The runs of opaque pixels of a row of premultiplied colour (their straight colour is the
-/// colour itself), each with the index of the pixel after it, if that is not opaque. Runs may
-/// be empty.
-#[inline]
-fn opaque_runs(colour: &[[f32; 4]]) -> impl Iterator<Item = (Range<usize>, Option<usize>)> + '_ {
-    let mut i = 0;
-    std::iter::from_fn(move || {
-        if i >= colour.len() {
-            return None;
-        }
-        let start = i;
-        let end = start + colour[start..].iter().take_while(|c| c[3] >= 1.0).count();
-        let other = (end < colour.len()).then_some(end);
-        i = end + usize::from(other.is_some());
-        Some((start..end, other))
-    })
+/// Pixels per block of a row that [`encode_row_plain`] and [`encode_row_dithered`] encode at
+/// once when all of them are opaque.
+const BLOCK: usize = 8;
+
+/// Whether the pixels of `block` (premultiplied colour) are all opaque: their straight colour is
+/// then the colour itself. `fold` with `&` rather than `all`: without an early exit the test
+/// vectorises.
+#[inline(always)]
+fn all_opaque(block: &[[f32; 4]; BLOCK]) -> bool {
+    block.iter().fold(true, |all, c| all & (c[3] >= 1.0))
 }
 
-/// Encodes a row of premultiplied sRGB-encoded colour without dither. Runs of opaque pixels
-/// (most of them) take a loop without branches, which vectorises.
+/// Calls `block(start, colour, out)` for each whole block of [`BLOCK`] pixels of a row and
+/// `one(i, colour, out)` for each pixel after them (`out`: their channels).
+#[inline(always)]
+fn for_each_block<P>(
+    out: &mut [P],
+    colour: &[[f32; 4]],
+    mut block: impl FnMut(usize, &[[f32; 4]; BLOCK], &mut [P; 4 * BLOCK]),
+    mut one: impl FnMut(usize, &[f32; 4], &mut [P]),
+) {
+    let mut out_blocks = out.chunks_exact_mut(4 * BLOCK);
+    let mut colour_blocks = colour.chunks_exact(BLOCK);
+    for (b, (dst, c)) in out_blocks.by_ref().zip(colour_blocks.by_ref()).enumerate() {
+        let dst: &mut [P; 4 * BLOCK] = dst.try_into().expect("a whole block");
+        block(b * BLOCK, c.try_into().expect("a whole block"), dst);
+    }
+    let start = colour.len() - colour_blocks.remainder().len();
+    let pixels = out_blocks.into_remainder().chunks_exact_mut(4);
+    for (k, (px, c)) in pixels.zip(colour_blocks.remainder()).enumerate() {
+        one(start + k, c, px);
+    }
+}
+
+/// Encodes a row of premultiplied sRGB-encoded colour without dither. Blocks of opaque pixels
+/// (most of them) take a loop of fixed length without branches, which vectorises; the others
+/// go pixel by pixel.
 // Always inlined: see `wide_vectors`.
 #[inline(always)]
 fn encode_row_plain<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]]) {
-    for (run, other) in opaque_runs(colour) {
-        // Alpha, at least 1, encodes as 1.
-        let channels = colour[run.clone()].as_flattened();
-        for (o, &v) in out[4 * run.start..4 * run.end].iter_mut().zip(channels) {
-            *o = P::encode_plain(if P::SATURATES { v } else { v.clamp(0.0, 1.0) });
+    let one = |_: usize, c: &[f32; 4], px: &mut [P]| {
+        let rgba = straight_srgb::<P>(c, false);
+        for ch in 0..4 {
+            px[ch] = P::encode_plain(rgba[ch]);
         }
-        if let Some(i) = other {
-            let rgba = straight_srgb::<P>(&colour[i], false);
-            for ch in 0..4 {
-                out[4 * i + ch] = P::encode_plain(rgba[ch]);
+    };
+    let block = |start: usize, c: &[[f32; 4]; BLOCK], dst: &mut [P; 4 * BLOCK]| {
+        if all_opaque(c) {
+            // Alpha, at least 1, encodes as 1.
+            for (o, &v) in dst.iter_mut().zip(c.as_flattened()) {
+                *o = P::encode_plain(if P::SATURATES { v } else { v.clamp(0.0, 1.0) });
+            }
+        } else {
+            for (k, (px, c)) in dst.chunks_exact_mut(4).zip(c).enumerate() {
+                one(start + k, c, px);
             }
         }
-    }
+    };
+    for_each_block(out, colour, block, one);
 }
 
-/// [`encode_row_plain`] with dither noise, for row `y`. In runs of opaque pixels the hashes
-/// of a chunk come first (64-bit, one at a time), then the noise and the encoding, which
-/// vectorise.
+/// [`encode_row_plain`] with dither noise, for row `y`. In a block of opaque pixels the hashes
+/// come first (64-bit, one at a time), then the noise and the encoding, which vectorise.
 // Always inlined: see `wide_vectors`.
 #[inline(always)]
 fn encode_row_dithered<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]], y: u32) {
-    const CHUNK: usize = 64;
-    let mut hashes = [0u64; CHUNK];
-    for (run, other) in opaque_runs(colour) {
-        for start in run.clone().step_by(CHUNK) {
-            let end = (start + CHUNK).min(run.end);
-            for (x, h) in (start..end).zip(&mut hashes) {
-                *h = output::dither_hash(x as u32, y);
-            }
-            let pixels = out[4 * start..4 * end].chunks_exact_mut(4);
-            for ((px, c), &h) in pixels.zip(&colour[start..end]).zip(&hashes) {
-                let noise = output::noise_of_hash(h);
-                // Alpha, at least 1, encodes as 1.
-                for ch in 0..4 {
-                    let v = if P::SATURATES {
-                        c[ch]
-                    } else {
-                        c[ch].clamp(0.0, 1.0)
-                    };
-                    px[ch] = P::encode_branchless(v, noise[ch]);
-                }
-            }
+    let one = |i: usize, c: &[f32; 4], px: &mut [P]| {
+        let rgba = straight_srgb::<P>(c, false);
+        let noise = output::dither_noise(i as u32, y);
+        for ch in 0..4 {
+            px[ch] = P::encode(rgba[ch], noise[ch]);
         }
-        if let Some(i) = other {
-            let rgba = straight_srgb::<P>(&colour[i], false);
-            let noise = output::dither_noise(i as u32, y);
+    };
+    let block = |start: usize, c: &[[f32; 4]; BLOCK], dst: &mut [P; 4 * BLOCK]| {
+        if !all_opaque(c) {
+            for (k, (px, c)) in dst.chunks_exact_mut(4).zip(c).enumerate() {
+                one(start + k, c, px);
+            }
+            return;
+        }
+        let mut hashes = [0u64; BLOCK];
+        for (k, h) in hashes.iter_mut().enumerate() {
+            *h = output::dither_hash((start + k) as u32, y);
+        }
+        for ((px, c), &h) in dst.chunks_exact_mut(4).zip(c).zip(&hashes) {
+            let noise = output::noise_of_hash(h);
+            // Alpha, at least 1, encodes as 1.
             for ch in 0..4 {
-                out[4 * i + ch] = P::encode(rgba[ch], noise[ch]);
+                let v = if P::SATURATES {
+                    c[ch]
+                } else {
+                    c[ch].clamp(0.0, 1.0)
+                };
+                px[ch] = P::encode_branchless(v, noise[ch]);
             }
         }
-    }
+    };
+    for_each_block(out, colour, block, one);
 }
 
 /// How one layer's attributes become colours of the blend space.
@@ -1145,5 +1169,73 @@ mod tests {
                 .zip(&baseline)
                 .all(|(a, b)| a.to_bits() == b.to_bits()));
         }
+    }
+}
+
+#[cfg(test)]
+mod encode_tests {
+    use super::*;
+
+    /// A row of premultiplied colours: a block of opaque pixels (one above the range), a block
+    /// with clear and translucent pixels, and five after the last whole block.
+    fn row() -> Vec<[f32; 4]> {
+        (0..2 * BLOCK + 5)
+            .map(|i| {
+                let alpha = match i {
+                    9 => 0.5,
+                    12 => 0.0,
+                    18 => 0.25,
+                    _ => 1.0,
+                };
+                let t = i as f32 / 21.0;
+                let rgb = [t, 1.0 - t, if i == 3 { 1.2 } else { 0.5 * t }];
+                [rgb[0] * alpha, rgb[1] * alpha, rgb[2] * alpha, alpha]
+            })
+            .collect()
+    }
+
+    fn plain_by_blocks_matches_pixels<P: OutputPixel + Default + PartialEq + std::fmt::Debug>() {
+        let colour = row();
+        let mut blocks = vec![P::default(); 4 * colour.len()];
+        encode_row_plain(&mut blocks, &colour);
+        let pixels: Vec<P> = colour
+            .iter()
+            .flat_map(|c| straight_srgb::<P>(c, false).map(P::encode_plain))
+            .collect();
+        assert_eq!(blocks, pixels);
+    }
+
+    /// Encoding a row by blocks gives the bits of encoding each pixel on its own.
+    #[test]
+    fn rows_encode_by_blocks_as_pixel_by_pixel() {
+        plain_by_blocks_matches_pixels::<u8>();
+        plain_by_blocks_matches_pixels::<u16>();
+        let colour = row();
+        let mut f = vec![0.0f32; 4 * colour.len()];
+        encode_row_plain(&mut f, &colour);
+        let expected: Vec<f32> = colour
+            .iter()
+            .flat_map(|c| straight_srgb::<f32>(c, false))
+            .collect();
+        assert!(f
+            .iter()
+            .zip(&expected)
+            .all(|(a, b)| a.to_bits() == b.to_bits()));
+
+        let y = 7;
+        let mut dithered = vec![0u8; 4 * colour.len()];
+        encode_row_dithered(&mut dithered, &colour, y);
+        let expected: Vec<u8> = colour
+            .iter()
+            .enumerate()
+            .flat_map(|(x, c)| {
+                let (rgba, noise) = (
+                    straight_srgb::<u8>(c, false),
+                    output::dither_noise(x as u32, y),
+                );
+                each4(|ch| u8::encode(rgba[ch], noise[ch]))
+            })
+            .collect();
+        assert_eq!(dithered, expected);
     }
 }
