@@ -535,6 +535,7 @@ fn render<P: OutputPixel>(
         .for_each(|(band, chunk)| {
             Scratch::with(w, |scratch| {
                 let job = Band {
+                    wide: false,
                     index: band,
                     out: chunk,
                     layers: &layers,
@@ -639,7 +640,7 @@ struct Run {
 fn draw_band_dispatched<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
     #[cfg(target_arch = "x86_64")]
     if wide_vectors::available() {
-        return wide_vectors::draw_band(job, s);
+        return wide_vectors::draw_band(Band { wide: true, ..job }, s);
     }
     draw_band_baseline(job, s)
 }
@@ -696,6 +697,8 @@ mod wide_vectors {
 
 /// One band of the image to draw: rows `index * BAND ..`, whose pixels are `out`.
 struct Band<'a, P> {
+    /// Whether this is the x86-64-v3 compilation, whose vectors some loops are written for.
+    wide: bool,
     index: usize,
     out: &'a mut [P],
     layers: &'a [&'a PreparedLayer],
@@ -708,6 +711,7 @@ struct Band<'a, P> {
 #[inline(always)]
 fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
     let Band {
+        wide,
         index: band,
         out,
         layers,
@@ -754,7 +758,7 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
         let (c0, c1) = layer.columns;
         let shading = Shading {
             space: layer.space,
-            converter: gamut::RunConverter::new(layer.space, opts.gamut, opts.blend),
+            converter: gamut::RunConverter::new(layer.space, opts.gamut, opts.blend, wide),
             gamut: opts.gamut,
             blend: opts.blend,
         };
