@@ -516,7 +516,9 @@ impl Triangle {
         let (dy, dx0) = ((y - o[1]) as f32, (x0 - o[0]) as f32);
         let row: [f32; 4] = each4(|k| self.at_origin[k] + self.gy[k] * dy + self.qyy[k] * dy * dy);
         let slope: [f32; 4] = each4(|k| self.gx[k] + self.qxy[k] * dy);
-        for (n, out) in out.iter_mut().enumerate() {
+        // An `i32` count: converting it to `f32` is one vector instruction, a `usize` one is
+        // one scalar instruction per lane. The same values (spans are far below 2^31).
+        for (n, out) in (0i32..).zip(out.iter_mut()) {
             let dx = dx0 + n as f32;
             *out = each4(|k| row[k] + (slope[k] + self.qxx[k] * dx) * dx);
         }
