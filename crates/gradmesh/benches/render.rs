@@ -1,10 +1,11 @@
 //! Whole renders of the gallery examples (`examples/*.json`) at 1024 pixels on the longer
 //! side, and the floor: filling the same RGBA `f32` buffer with one colour. Then the authors'
 //! six-layer Tucan at 1024 pixels wide into an 8-bit buffer, from scratch and as an editor
-//! re-renders it after one layer changed (`RenderCache`).
+//! re-renders it after one layer changed (`RenderCache`); Glasses at 1024 and both at 4096
+//! pixels wide (`artwork`).
 //!
 //! Run: `cargo bench -p gradmesh --bench render` (add a name to run one example, e.g.
-//! `-- rectangle`, or `-- tucan` for the editing figures).
+//! `-- rectangle`, `-- tucan_1024` for the editing figures, `-- artwork` for the others).
 
 #![allow(missing_docs)] // criterion_group! generates undocumented items.
 
@@ -56,17 +57,49 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-/// The six Tucan layers, bottom to top, from the shared real data beside the repository.
-fn tucan() -> Option<Document> {
+/// The authors' real files: `names` from the shared real data beside the repository, as the
+/// layers of one document, bottom to top.
+fn real_document(names: &[String]) -> Option<Document> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/realdata/gradientmeshimproved-off");
     let mut layers = Vec::new();
-    for i in (0..6).rev() {
-        let path = dir.join(format!("Tucan_Tucan_Layer{i}.off"));
-        let mut doc = formats::read_path(&path).ok()?;
-        layers.push(doc.layers.remove(0));
+    for name in names {
+        layers.extend(formats::read_path(&dir.join(name)).ok()?.layers);
     }
     Some(Document { layers })
+}
+
+/// The six Tucan layers, bottom to top (the README's order).
+fn tucan() -> Option<Document> {
+    let names: Vec<String> = (0..6)
+        .rev()
+        .map(|i| format!("Tucan_Tucan_Layer{i}.off"))
+        .collect();
+    real_document(&names)
+}
+
+/// The absolute targets on the real artwork: Glasses at 1024 pixels wide, and both
+/// at 4096 (print size), into 8-bit buffers as the command line writes them (Tucan at 1024 is
+/// `tucan_1024/from_scratch`).
+fn bench_artwork(c: &mut Criterion) {
+    let (Some(tucan), Some(glasses)) = (tucan(), real_document(&["Glasses.off".into()])) else {
+        eprintln!("shared/realdata not found: skipping the artwork benchmarks");
+        return;
+    };
+    let mut g = c.benchmark_group("artwork");
+    g.sample_size(10).measurement_time(Duration::from_secs(5));
+    for (name, doc, width) in [
+        ("glasses_1024", &glasses, 1024),
+        ("glasses_4096", &glasses, 4096),
+        ("tucan_4096", &tucan, 4096),
+    ] {
+        let opts = RenderOptions::fit(doc, width);
+        let mut buffer = vec![0u8; 4 * (opts.width * opts.height) as usize];
+        g.bench_function(name, |b| {
+            b.iter(|| render_document_into(black_box(doc), &opts, &mut buffer).unwrap())
+        });
+    }
+    g.finish();
 }
 
 fn bench_editing(c: &mut Criterion) {
@@ -100,5 +133,5 @@ fn bench_editing(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench, bench_editing);
+criterion_group!(benches, bench, bench_editing, bench_artwork);
 criterion_main!(benches);
