@@ -421,31 +421,36 @@ fn srgb_encode_f32_with(table: &[f32], linear: f32) -> f32 {
             srgb_encode(linear as f64) as f32
         };
     }
-    // Within octave [2^e, 2^(e+1)) the value is linear in the mantissa; 0.0031308 > 2^-9.
-    let bits = linear.to_bits();
-    let exponent = ((bits >> 23) & 0xff) as i32 - 127;
-    let mantissa = bits & ((1 << 23) - 1);
-    let shift = 23 - ENCODE_STEPS_F32.trailing_zeros();
-    let step = (mantissa >> shift) as usize;
-    let frac = (mantissa & ((1 << shift) - 1)) as f32 / (1u32 << shift) as f32;
-    let i = (exponent + ENCODE_OCTAVES as i32) as usize * ENCODE_STEPS_F32 as usize + step;
+    let (i, frac) = table_position(linear);
+    let i = i as usize;
     table[i] + frac * (table[i + 1] - table[i])
 }
 
-/// [`srgb_encode_f32_with`] of a value in `0..=1`, bit for bit, without branches: both
-/// pieces are computed and one chosen, and the table index is clamped (for values outside
-/// `0..=1` the result is meaningless, but nothing panics). A loop over many values vectorises,
-/// its table reads becoming gathers where the CPU has them.
+/// Where `linear` falls in the table of [`srgb_encode_f32`]: the index of the entry at or
+/// below it (meaningful for values in `[2^-9, 1)`) and the fraction of the way to the next.
+/// Within octave `[2^e, 2^(e+1))` the value is linear in the mantissa; 0.0031308 > 2^-9.
 #[inline(always)]
-fn srgb_encode_unit_f32(table: &[f32; ENCODE_TABLE_F32_LEN], linear: f32) -> f32 {
+fn table_position(linear: f32) -> (i32, f32) {
     let bits = linear.to_bits();
     let exponent = ((bits >> 23) & 0xff) as i32 - 127;
     let mantissa = bits & ((1 << 23) - 1);
     let shift = 23 - ENCODE_STEPS_F32.trailing_zeros();
     let step = (mantissa >> shift) as i32;
     let frac = (mantissa & ((1 << shift) - 1)) as f32 / (1u32 << shift) as f32;
-    let i = ((exponent + ENCODE_OCTAVES as i32) * ENCODE_STEPS_F32 as i32 + step)
-        .clamp(0, ENCODE_TABLE_F32_LEN as i32 - 2) as usize;
+    (
+        (exponent + ENCODE_OCTAVES as i32) * ENCODE_STEPS_F32 as i32 + step,
+        frac,
+    )
+}
+
+/// [`srgb_encode_f32_with`] of a value in `0..=1`, bit for bit, without branches: both
+/// pieces are computed and one chosen, and the table index is clamped (for values outside
+/// `0..=1` the result is meaningless, but nothing panics), so that a loop over many values
+/// vectorises (the table reads stay scalar loads).
+#[inline(always)]
+fn srgb_encode_unit_f32(table: &[f32; ENCODE_TABLE_F32_LEN], linear: f32) -> f32 {
+    let (i, frac) = table_position(linear);
+    let i = i.clamp(0, ENCODE_TABLE_F32_LEN as i32 - 2) as usize;
     let tabled = table[i] + frac * (table[i + 1] - table[i]);
     let low = 12.92 * linear;
     if linear <= 0.003_130_8 {
