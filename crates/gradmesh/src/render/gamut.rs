@@ -410,7 +410,9 @@ pub(crate) fn srgb_encode_f32(linear: f32) -> f32 {
 /// [`srgb_encode_f32`] with its `table` ([`encode_table_f32`]) at hand.
 #[inline(always)]
 fn srgb_encode_f32_with(table: &[f32], linear: f32) -> f32 {
-    if linear <= 0.003_130_8 || linear >= 1.0 {
+    // Written so that NaN takes this branch too (and comes back NaN): the table has no row
+    // for it.
+    if !(linear > 0.003_130_8 && linear < 1.0) {
         return if (0.0..=1.0).contains(&linear) {
             if linear == 1.0 {
                 1.0
@@ -651,10 +653,11 @@ mod tests {
                 "{v}"
             );
         }
-        // Outside, meaningless but no panic.
+        // Outside, meaningless but no panic; the other gives NaN for NaN.
         for v in [f32::NAN, -1.0, 2.0, f32::INFINITY, f32::MAX, -0.0] {
             srgb_encode_unit_f32(table, v);
         }
+        assert!(srgb_encode_f32(f32::NAN).is_nan());
     }
 
     #[test]
