@@ -875,20 +875,30 @@ fn all_opaque(block: &[[f32; 4]; BLOCK]) -> bool {
     block.iter().fold(true, |all, c| all & (c[3] >= 1.0))
 }
 
-/// Calls `block(start, colour, out)` for each whole block of [`BLOCK`] pixels of a row and
-/// `one(i, colour, out)` for each pixel after them (`out`: their channels).
+/// Splits a row into blocks of [`BLOCK`] pixels: calls `opaque(start, colour, out)` for each
+/// whole block whose pixels are all opaque, and `one(i, colour, out)` for every other pixel
+/// (`out`: the pixels' channels).
 #[inline(always)]
 fn for_each_block<P>(
     out: &mut [P],
     colour: &[[f32; 4]],
-    mut block: impl FnMut(usize, &[[f32; 4]; BLOCK], &mut [P; 4 * BLOCK]),
+    mut opaque: impl FnMut(usize, &[[f32; 4]; BLOCK], &mut [P; 4 * BLOCK]),
     mut one: impl FnMut(usize, &[f32; 4], &mut [P]),
 ) {
     let mut out_blocks = out.chunks_exact_mut(4 * BLOCK);
     let mut colour_blocks = colour.chunks_exact(BLOCK);
     for (b, (dst, c)) in out_blocks.by_ref().zip(colour_blocks.by_ref()).enumerate() {
-        let dst: &mut [P; 4 * BLOCK] = dst.try_into().expect("a whole block");
-        block(b * BLOCK, c.try_into().expect("a whole block"), dst);
+        let (dst, c): (&mut [P; 4 * BLOCK], &[[f32; 4]; BLOCK]) = (
+            dst.try_into().expect("a whole block"),
+            c.try_into().expect("a whole block"),
+        );
+        if all_opaque(c) {
+            opaque(b * BLOCK, c, dst);
+        } else {
+            for (k, (px, c)) in dst.chunks_exact_mut(4).zip(c).enumerate() {
+                one(b * BLOCK + k, c, px);
+            }
+        }
     }
     let start = colour.len() - colour_blocks.remainder().len();
     let pixels = out_blocks.into_remainder().chunks_exact_mut(4);
@@ -903,25 +913,19 @@ fn for_each_block<P>(
 // Always inlined: see `wide_vectors`.
 #[inline(always)]
 fn encode_row_plain<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]]) {
+    let opaque = |_: usize, c: &[[f32; 4]; BLOCK], dst: &mut [P; 4 * BLOCK]| {
+        // Alpha, at least 1, encodes as 1.
+        for (o, &v) in dst.iter_mut().zip(c.as_flattened()) {
+            *o = P::encode_plain(if P::SATURATES { v } else { v.clamp(0.0, 1.0) });
+        }
+    };
     let one = |_: usize, c: &[f32; 4], px: &mut [P]| {
         let rgba = straight_srgb::<P>(c, false);
         for ch in 0..4 {
             px[ch] = P::encode_plain(rgba[ch]);
         }
     };
-    let block = |start: usize, c: &[[f32; 4]; BLOCK], dst: &mut [P; 4 * BLOCK]| {
-        if all_opaque(c) {
-            // Alpha, at least 1, encodes as 1.
-            for (o, &v) in dst.iter_mut().zip(c.as_flattened()) {
-                *o = P::encode_plain(if P::SATURATES { v } else { v.clamp(0.0, 1.0) });
-            }
-        } else {
-            for (k, (px, c)) in dst.chunks_exact_mut(4).zip(c).enumerate() {
-                one(start + k, c, px);
-            }
-        }
-    };
-    for_each_block(out, colour, block, one);
+    for_each_block(out, colour, opaque, one);
 }
 
 /// [`encode_row_plain`] with dither noise, for row `y`. In a block of opaque pixels the hashes
@@ -929,20 +933,7 @@ fn encode_row_plain<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]]) {
 // Always inlined: see `wide_vectors`.
 #[inline(always)]
 fn encode_row_dithered<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]], y: u32) {
-    let one = |i: usize, c: &[f32; 4], px: &mut [P]| {
-        let rgba = straight_srgb::<P>(c, false);
-        let noise = output::dither_noise(i as u32, y);
-        for ch in 0..4 {
-            px[ch] = P::encode(rgba[ch], noise[ch]);
-        }
-    };
-    let block = |start: usize, c: &[[f32; 4]; BLOCK], dst: &mut [P; 4 * BLOCK]| {
-        if !all_opaque(c) {
-            for (k, (px, c)) in dst.chunks_exact_mut(4).zip(c).enumerate() {
-                one(start + k, c, px);
-            }
-            return;
-        }
+    let opaque = |start: usize, c: &[[f32; 4]; BLOCK], dst: &mut [P; 4 * BLOCK]| {
         let mut hashes = [0u64; BLOCK];
         for (k, h) in hashes.iter_mut().enumerate() {
             *h = output::dither_hash((start + k) as u32, y);
@@ -960,7 +951,14 @@ fn encode_row_dithered<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]], y: u3
             }
         }
     };
-    for_each_block(out, colour, block, one);
+    let one = |i: usize, c: &[f32; 4], px: &mut [P]| {
+        let rgba = straight_srgb::<P>(c, false);
+        let noise = output::dither_noise(i as u32, y);
+        for ch in 0..4 {
+            px[ch] = P::encode(rgba[ch], noise[ch]);
+        }
+    };
+    for_each_block(out, colour, opaque, one);
 }
 
 /// How one layer's attributes become colours of the blend space.
