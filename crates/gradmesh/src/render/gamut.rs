@@ -47,6 +47,32 @@ impl GamutMapping {
             GamutMapping::Chroma => reduce_chroma(rgb),
         }
     }
+
+    /// [`GamutMapping::apply`] of `N` colours at once, with the same bits for each. The chroma
+    /// search runs in lanes (see [`reduce_chroma_lanes`]): its divisions and square roots
+    /// overlap, and its decisions are selections rather than branches the processor guesses.
+    #[inline(always)]
+    pub(crate) fn apply_lanes<const N: usize>(self, rgb: [[f64; 3]; N]) -> [[f64; 3]; N] {
+        match self {
+            GamutMapping::Clip => rgb.map(|c| self.apply(c)),
+            GamutMapping::Chroma => {
+                let mut channels = [[0.0; N]; 3];
+                for (i, c) in rgb.iter().enumerate() {
+                    for k in 0..3 {
+                        channels[k][i] = c[k];
+                    }
+                }
+                let mapped = reduce_chroma_lanes(channels);
+                let mut out = rgb;
+                for (i, c) in out.iter_mut().enumerate() {
+                    if !in_gamut(*c, 0.0) {
+                        *c = [mapped[0][i], mapped[1][i], mapped[2][i]];
+                    }
+                }
+                out
+            }
+        }
+    }
 }
 
 /// The space in which layers are composited (source-over, premultiplied alpha), and in which the
@@ -175,6 +201,8 @@ fn to_blend_space_wide(
 
 /// Colours per run of [`RunConverter::convert`].
 pub(crate) const RUN: usize = 64;
+// `RunConverter::convert` keeps indices into a run in bytes.
+const _: () = assert!(RUN <= 256);
 
 /// [`to_blend_space_f32`] for runs of up to [`RUN`] colours of one layer, with the same bits:
 /// the colours come as one array per channel, so that the Lab part is a loop over whole
@@ -241,6 +269,9 @@ impl RunConverter {
                 }
             }
         }
+        // Colours outside the gamut in single precision, converted after the loop.
+        let mut outside = [0u8; RUN];
+        let mut outside_count = 0;
         for m in 0..n {
             let l = [lin[0][m], lin[1][m], lin[2][m]];
             if in_unit(&l) {
@@ -253,8 +284,33 @@ impl RunConverter {
                 // copied out with a load wider than its stores, which stalled every pixel.
                 out[m].copy_from_slice(&e);
             } else {
-                let colour = [c[0][m], c[1][m], c[2][m]];
-                out[m] = to_blend_space_wide(self.space, colour, self.gamut, self.blend);
+                outside[outside_count] = m as u8;
+                outside_count += 1;
+            }
+        }
+        if outside_count > 0 {
+            self.convert_outside(c, &outside[..outside_count], out);
+        }
+    }
+
+    /// [`to_blend_space_wide`] of the Lab colours `c[..][m]` for each `m` in `indices`, into
+    /// `out[m]`: in double precision, and gamut-mapped [`GAMUT_LANES`] colours at a time.
+    #[inline(always)]
+    fn convert_outside(&self, c: &[[f32; RUN]; 3], indices: &[u8], out: &mut [[f32; 3]; RUN]) {
+        for chunk in indices.chunks(GAMUT_LANES) {
+            // Unused lanes hold mid grey, which is inside and costs the search nothing.
+            let mut lin = [[0.5; 3]; GAMUT_LANES];
+            for (l, &m) in lin.iter_mut().zip(chunk) {
+                let m = usize::from(m);
+                *l = lab_to_linear_srgb([c[0][m], c[1][m], c[2][m]].map(f64::from));
+            }
+            let mapped = self.gamut.apply_lanes(lin);
+            for (&m, rgb) in chunk.iter().zip(mapped) {
+                let encoded = match self.blend {
+                    BlendSpace::Linear => rgb,
+                    BlendSpace::Srgb => rgb.map(srgb_encode_fast),
+                };
+                out[usize::from(m)] = encoded.map(|v| v as f32);
             }
         }
     }
@@ -473,106 +529,198 @@ fn clip(rgb: [f64; 3]) -> [f64; 3] {
     rgb.map(|v| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) })
 }
 
-/// Linear-light sRGB to Oklab (Ottosson 2020).
-pub(crate) fn linear_srgb_to_oklab(c: [f64; 3]) -> [f64; 3] {
-    let [r, g, b] = c;
-    let l = 0.412_221_470_8 * r + 0.536_332_536_3 * g + 0.051_445_992_9 * b;
-    let m = 0.211_903_498_2 * r + 0.680_699_545_1 * g + 0.107_396_956_6 * b;
-    let s = 0.088_302_461_9 * r + 0.281_718_837_6 * g + 0.629_978_700_5 * b;
-    let (l, m, s) = (cube_root(l), cube_root(m), cube_root(s));
-    [
-        0.210_454_255_3 * l + 0.793_617_785_0 * m - 0.004_072_046_8 * s,
-        1.977_998_495_1 * l - 2.428_592_205_0 * m + 0.450_593_709_9 * s,
-        0.025_904_037_1 * l + 0.782_771_766_2 * m - 0.808_675_766_0 * s,
-    ]
+/// CSS Color 4's chroma search ([`reduce_chroma_lanes`]) for one colour.
+fn reduce_chroma(rgb: [f64; 3]) -> [f64; 3] {
+    reduce_chroma_lanes(rgb.map(|v| [v])).map(|[v]| v)
 }
 
-/// The real cube root, to within a few units in the last place. `f64::cbrt` is correctly
-/// rounded but, on baseline x86-64 (no fused multiply-add instruction), emulates `fma` in
-/// software: it was two thirds of drawing an image with many colours outside the gamut, whose
-/// chroma search takes about 36 cube roots per pixel.
-#[inline]
-fn cube_root(x: f64) -> f64 {
-    let a = x.abs();
-    if !a.is_normal() {
-        // Zero, subnormal, infinite or NaN: rare, and the library has the edge cases right.
-        return x.cbrt();
+/// Colours mapped together by [`GamutMapping::apply_lanes`]: four double-precision lanes fill
+/// an AVX2 vector.
+pub(crate) const GAMUT_LANES: usize = 4;
+
+/// Linear-light sRGB to Oklab (Ottosson 2020), lane by lane; channels outermost.
+#[inline(always)]
+fn linear_srgb_to_oklab_lanes<const N: usize>(c: &[[f64; N]; 3]) -> [[f64; N]; 3] {
+    const TO_LMS: [[f64; 3]; 3] = [
+        [0.412_221_470_8, 0.536_332_536_3, 0.051_445_992_9],
+        [0.211_903_498_2, 0.680_699_545_1, 0.107_396_956_6],
+        [0.088_302_461_9, 0.281_718_837_6, 0.629_978_700_5],
+    ];
+    let mut lms = [[0.0; N]; 3];
+    for (row, w) in lms.iter_mut().zip(TO_LMS) {
+        for i in 0..N {
+            row[i] = w[0] * c[0][i] + w[1] * c[1][i] + w[2] * c[2][i];
+        }
     }
+    let [l, m, s] = cube_root_lanes(lms);
+    let mut out = [[0.0; N]; 3];
+    for i in 0..N {
+        out[0][i] = 0.210_454_255_3 * l[i] + 0.793_617_785_0 * m[i] - 0.004_072_046_8 * s[i];
+        out[1][i] = 1.977_998_495_1 * l[i] - 2.428_592_205_0 * m[i] + 0.450_593_709_9 * s[i];
+        out[2][i] = 0.025_904_037_1 * l[i] + 0.782_771_766_2 * m[i] - 0.808_675_766_0 * s[i];
+    }
+    out
+}
+
+/// The real cube root of each lane, to within a few units in the last place. `f64::cbrt` is
+/// correctly rounded but, on baseline x86-64 (no fused multiply-add instruction), emulates
+/// `fma` in software: it was two thirds of drawing an image with many colours outside the
+/// gamut, whose chroma search takes about 36 cube roots per pixel.
+#[inline(always)]
+fn cube_root_lanes<const N: usize, const M: usize>(x: [[f64; N]; M]) -> [[f64; N]; M] {
     // A first guess within a few percent from the exponent (a third of it, by integer
     // division of the bits), then Halley's iteration, which triples the correct digits.
-    let mut y = f64::from_bits(a.to_bits() / 3 + 0x2A9F_7893_782D_A1CE);
-    for _ in 0..3 {
-        let y3 = y * y * y;
-        y *= (y3 + 2.0 * a) / (2.0 * y3 + a);
+    let mut a = [[1.0; N]; M];
+    let mut y = [[0.0; N]; M];
+    let mut irregular = false;
+    for j in 0..M {
+        for i in 0..N {
+            let v = x[j][i].abs();
+            irregular |= !v.is_normal();
+            if v.is_normal() {
+                a[j][i] = v;
+            }
+            y[j][i] = f64::from_bits(a[j][i].to_bits() / 3 + 0x2A9F_7893_782D_A1CE);
+        }
     }
-    y.copysign(x)
+    for _ in 0..3 {
+        for j in 0..M {
+            for i in 0..N {
+                let y3 = y[j][i] * y[j][i] * y[j][i];
+                y[j][i] *= (y3 + 2.0 * a[j][i]) / (2.0 * y3 + a[j][i]);
+            }
+        }
+    }
+    for j in 0..M {
+        for i in 0..N {
+            y[j][i] = y[j][i].copysign(x[j][i]);
+        }
+    }
+    if irregular {
+        // Zero, subnormal, infinite or NaN: rare, and the library has the edge cases right.
+        for j in 0..M {
+            for i in 0..N {
+                if !x[j][i].abs().is_normal() {
+                    y[j][i] = x[j][i].cbrt();
+                }
+            }
+        }
+    }
+    y
 }
 
-/// Oklab to linear-light sRGB.
-pub(crate) fn oklab_to_linear_srgb(c: [f64; 3]) -> [f64; 3] {
-    let [ll, a, b] = c;
-    let l = ll + 0.396_337_777_4 * a + 0.215_803_757_3 * b;
-    let m = ll - 0.105_561_345_8 * a - 0.063_854_172_8 * b;
-    let s = ll - 0.089_484_177_5 * a - 1.291_485_548_0 * b;
-    let (l, m, s) = (l * l * l, m * m * m, s * s * s);
-    [
-        4.076_741_662_1 * l - 3.307_711_591_3 * m + 0.230_969_929_2 * s,
-        -1.268_438_004_6 * l + 2.609_757_401_1 * m - 0.341_319_396_5 * s,
-        -0.004_196_086_3 * l - 0.703_418_614_7 * m + 1.707_614_701_0 * s,
-    ]
+/// Oklab to linear-light sRGB, lane by lane; channels outermost.
+#[inline(always)]
+fn oklab_to_linear_srgb_lanes<const N: usize>(c: &[[f64; N]; 3]) -> [[f64; N]; 3] {
+    let mut out = [[0.0; N]; 3];
+    for i in 0..N {
+        let (ll, a, b) = (c[0][i], c[1][i], c[2][i]);
+        let l = ll + 0.396_337_777_4 * a + 0.215_803_757_3 * b;
+        let m = ll - 0.105_561_345_8 * a - 0.063_854_172_8 * b;
+        let s = ll - 0.089_484_177_5 * a - 1.291_485_548_0 * b;
+        let (l, m, s) = (l * l * l, m * m * m, s * s * s);
+        out[0][i] = 4.076_741_662_1 * l - 3.307_711_591_3 * m + 0.230_969_929_2 * s;
+        out[1][i] = -1.268_438_004_6 * l + 2.609_757_401_1 * m - 0.341_319_396_5 * s;
+        out[2][i] = -0.004_196_086_3 * l - 0.703_418_614_7 * m + 1.707_614_701_0 * s;
+    }
+    out
 }
 
-fn delta_e_ok(a: [f64; 3], b: [f64; 3]) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+/// Each lane clamped to `0..=1`, NaN to 0.
+#[inline(always)]
+fn clip_lanes<const N: usize>(c: &[[f64; N]; 3]) -> [[f64; N]; 3] {
+    c.map(|channel| channel.map(|v| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) }))
+}
+
+/// The Oklab distance between `a` and `b`, lane by lane.
+#[inline(always)]
+fn delta_e_ok_lanes<const N: usize>(a: &[[f64; N]; 3], b: &[[f64; N]; 3]) -> [f64; N] {
+    let mut out = [0.0; N];
+    for i in 0..N {
+        let d = [a[0][i] - b[0][i], a[1][i] - b[1][i], a[2][i] - b[2][i]];
+        out[i] = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    }
+    out
 }
 
 /// CSS Color 4's binary search for the largest chroma (at the colour's Oklab lightness and hue)
-/// whose clipped version is within a just-noticeable difference of it.
-fn reduce_chroma(rgb: [f64; 3]) -> [f64; 3] {
+/// whose clipped version is within a just-noticeable difference of it, for `N` colours at once
+/// (channels outermost). Every lane takes the steps it would take alone, with the same
+/// arithmetic, so the result does not depend on its neighbours; the lanes only share the loop,
+/// which runs until the last of them is found.
+#[inline(always)]
+fn reduce_chroma_lanes<const N: usize>(rgb: [[f64; N]; 3]) -> [[f64; N]; 3] {
     const JND: f64 = 0.02;
     const EPSILON: f64 = 1e-4;
-    if rgb.iter().any(|v| !v.is_finite()) {
-        return clip(rgb);
-    }
-    let lab = linear_srgb_to_oklab(rgb);
-    let l = lab[0];
-    if l >= 1.0 {
-        return [1.0; 3];
-    }
-    if l <= 0.0 {
-        return [0.0; 3];
-    }
-    let chroma = lab[1].hypot(lab[2]);
-    if chroma == 0.0 {
-        return clip(rgb);
-    }
-    let (ua, ub) = (lab[1] / chroma, lab[2] / chroma);
-    let with_chroma = |c: f64| [l, c * ua, c * ub];
-
-    let mut clipped = clip(rgb);
-    if delta_e_ok(linear_srgb_to_oklab(clipped), lab) < JND {
-        return clipped;
-    }
-    let (mut min, mut max) = (0.0, chroma);
-    let mut min_in_gamut = true;
-    while max - min > EPSILON {
-        let c = 0.5 * (min + max);
-        let current = with_chroma(c);
-        let current_rgb = oklab_to_linear_srgb(current);
-        if min_in_gamut && in_gamut(current_rgb, 0.0) {
-            min = c;
-            continue;
-        }
-        clipped = clip(current_rgb);
-        let e = delta_e_ok(linear_srgb_to_oklab(clipped), current);
-        if e < JND {
-            if JND - e < EPSILON {
-                return clipped;
+    // Each lane's answer so far: the plain clip, unless the search below finds better.
+    let mut clipped = clip_lanes(&rgb);
+    // Lanes still searching.
+    let mut searching = [true; N];
+    let lab = linear_srgb_to_oklab_lanes(&rgb);
+    let (mut ua, mut ub) = ([0.0; N], [0.0; N]);
+    let mut max = [0.0; N];
+    for i in 0..N {
+        let l = lab[0][i];
+        let chroma = lab[1][i].hypot(lab[2][i]);
+        if !rgb.iter().all(|channel| channel[i].is_finite()) {
+            searching[i] = false;
+        } else if l >= 1.0 || l <= 0.0 {
+            let v = if l >= 1.0 { 1.0 } else { 0.0 };
+            for channel in &mut clipped {
+                channel[i] = v;
             }
-            min_in_gamut = false;
-            min = c;
-        } else {
-            max = c;
+            searching[i] = false;
+        } else if chroma == 0.0 {
+            searching[i] = false;
+        }
+        (ua[i], ub[i], max[i]) = (lab[1][i] / chroma, lab[2][i] / chroma, chroma);
+    }
+    // The plain clip, when it is close enough already.
+    let e = delta_e_ok_lanes(&linear_srgb_to_oklab_lanes(&clip_lanes(&rgb)), &lab);
+    for i in 0..N {
+        searching[i] &= e[i] >= JND;
+    }
+    let mut min = [0.0; N];
+    let mut min_in_gamut = [true; N];
+    loop {
+        for i in 0..N {
+            searching[i] &= max[i] - min[i] > EPSILON;
+        }
+        if !searching.contains(&true) {
+            break;
+        }
+        let mut c = [0.0; N];
+        let mut current = [[0.0; N]; 3];
+        for i in 0..N {
+            c[i] = 0.5 * (min[i] + max[i]);
+            current[0][i] = lab[0][i];
+            current[1][i] = c[i] * ua[i];
+            current[2][i] = c[i] * ub[i];
+        }
+        let current_rgb = oklab_to_linear_srgb_lanes(&current);
+        let current_clipped = clip_lanes(&current_rgb);
+        let e = delta_e_ok_lanes(&linear_srgb_to_oklab_lanes(&current_clipped), &current);
+        for i in 0..N {
+            if !searching[i] {
+                continue;
+            }
+            let inside = (0..3).all(|k| (0.0..=1.0).contains(&current_rgb[k][i]));
+            if min_in_gamut[i] && inside {
+                min[i] = c[i];
+                continue;
+            }
+            for k in 0..3 {
+                clipped[k][i] = current_clipped[k][i];
+            }
+            if e[i] < JND {
+                if JND - e[i] < EPSILON {
+                    searching[i] = false;
+                }
+                min_in_gamut[i] = false;
+                min[i] = c[i];
+            } else {
+                max[i] = c[i];
+            }
         }
     }
     clipped
@@ -581,6 +729,21 @@ fn reduce_chroma(rgb: [f64; 3]) -> [f64; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Linear-light sRGB to Oklab (Ottosson 2020).
+    fn linear_srgb_to_oklab(c: [f64; 3]) -> [f64; 3] {
+        linear_srgb_to_oklab_lanes(&c.map(|v| [v])).map(|[v]| v)
+    }
+
+    /// Oklab to linear-light sRGB.
+    fn oklab_to_linear_srgb(c: [f64; 3]) -> [f64; 3] {
+        oklab_to_linear_srgb_lanes(&c.map(|v| [v])).map(|[v]| v)
+    }
+
+    /// The real cube root, to within a few units in the last place.
+    fn cube_root(x: f64) -> f64 {
+        cube_root_lanes([[x]])[0][0]
+    }
 
     #[test]
     fn lab_conversion_matches_palette() {
@@ -826,5 +989,44 @@ mod tests {
             GamutMapping::Clip.apply([f64::NAN, 2.0, -1.0]),
             [0.0, 1.0, 0.0]
         );
+    }
+
+    #[test]
+    fn chroma_search_in_lanes_is_lane_independent() {
+        let mut seed = 12345u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut colours = vec![];
+        for _ in 0..20_000 {
+            let lab = [
+                120.0 * next() - 10.0,
+                260.0 * next() - 130.0,
+                260.0 * next() - 130.0,
+            ];
+            colours.push(ColourSpace::Lab.to_linear_srgb(lab));
+        }
+        colours.extend([
+            [0.0; 3],
+            [1.0; 3],
+            [1.0, 1.0, 1.2],
+            [f64::NAN, 0.5, 0.5],
+            [f64::INFINITY, 0.0, 0.0],
+            [-0.2, -0.1, -0.3],
+            [0.5, 0.5, 0.5],
+            [2.0, 2.0, 2.0],
+        ]);
+        for chunk in colours.chunks_exact(4) {
+            let lanes = GamutMapping::Chroma.apply_lanes([chunk[0], chunk[1], chunk[2], chunk[3]]);
+            for (c, l) in chunk.iter().zip(lanes) {
+                let s = GamutMapping::Chroma.apply(*c);
+                assert_eq!(s.map(f64::to_bits), l.map(f64::to_bits), "{c:?}");
+                let one = GamutMapping::Chroma.apply_lanes([*c]);
+                assert_eq!(s.map(f64::to_bits), one[0].map(f64::to_bits), "{c:?}");
+            }
+        }
     }
 }
