@@ -11,6 +11,7 @@ mod common;
 use criterion::{black_box, criterion_group, criterion_main, BatchSize, Criterion};
 use gradmesh::catmull_clark;
 use gradmesh::limit::limit_stencils;
+use gradmesh::render::GamutMapping;
 use gradmesh::ternary_step::{ternary_data, ternary_level};
 use gradmesh::validate::BaseMesh;
 use gradmesh::ColourSpace;
@@ -68,6 +69,39 @@ fn bench(c: &mut Criterion) {
             )
         });
     }
+    g.finish();
+
+    // The same colours in linear sRGB, about two thirds of them outside the gamut: CSS Color
+    // 4's chroma search, colour by colour and sixteen at a time.
+    let linear: Vec<[f64; 3]> = colours
+        .iter()
+        .map(|&c| ColourSpace::Lab.to_linear_srgb(c))
+        .collect();
+    let outside = linear
+        .iter()
+        .filter(|c| c.iter().any(|v| !(0.0..=1.0).contains(v)))
+        .count();
+    assert!(outside > linear.len() / 2, "{outside} outside");
+    let mut g = c.benchmark_group("gamut_map_1m");
+    g.sample_size(10);
+    g.bench_function("chroma_one_by_one", |b| {
+        b.iter_batched_ref(
+            || linear.clone(),
+            |buffer| {
+                for c in buffer.iter_mut() {
+                    *c = GamutMapping::Chroma.apply(*c);
+                }
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    g.bench_function("chroma_all_at_once", |b| {
+        b.iter_batched_ref(
+            || linear.clone(),
+            |buffer| GamutMapping::Chroma.apply_to_all(buffer),
+            BatchSize::LargeInput,
+        )
+    });
     g.finish();
 }
 

@@ -48,6 +48,51 @@ impl GamutMapping {
         }
     }
 
+    /// [`GamutMapping::apply`] to every colour of `colours`, in place: the same bits as one
+    /// by one, in less time where many colours lie outside the gamut (the chroma search then
+    /// runs on sixteen colours at once).
+    ///
+    /// ```
+    /// use gradmesh::render::GamutMapping;
+    /// let mut colours = [[1.2, 0.5, -0.1], [0.2, 0.4, 0.6]];
+    /// let one_by_one = colours.map(|c| GamutMapping::Chroma.apply(c));
+    /// GamutMapping::Chroma.apply_to_all(&mut colours);
+    /// assert_eq!(colours, one_by_one);
+    /// ```
+    pub fn apply_to_all(self, colours: &mut [[f64; 3]]) {
+        super::map_gamut_dispatched(self, colours)
+    }
+
+    /// [`GamutMapping::apply_to_all`], inlined into each compilation of it.
+    #[inline(always)]
+    pub(crate) fn apply_to_all_inlined(self, colours: &mut [[f64; 3]]) {
+        if self == GamutMapping::Clip {
+            colours.iter_mut().for_each(|c| *c = self.apply(*c));
+            return;
+        }
+        // Only colours outside take lanes: one inside would idle in its lane while the others
+        // search.
+        let mut group = [0; GAMUT_LANES];
+        let mut n = 0;
+        for i in 0..colours.len() {
+            if in_gamut(colours[i], 0.0) {
+                continue;
+            }
+            group[n] = i;
+            n += 1;
+            if n == GAMUT_LANES {
+                let mapped = self.apply_lanes(group.map(|i| colours[i]));
+                for (&i, c) in group.iter().zip(mapped) {
+                    colours[i] = c;
+                }
+                n = 0;
+            }
+        }
+        for &i in &group[..n] {
+            colours[i] = self.apply(colours[i]);
+        }
+    }
+
     /// [`GamutMapping::apply`] of `N` colours at once, with the same bits for each. The chroma
     /// search runs in lanes (see [`reduce_chroma_lanes`]): its divisions and square roots
     /// overlap, and its decisions are selections rather than branches the processor guesses.
@@ -647,7 +692,15 @@ fn oklab_to_linear_srgb_lanes<const N: usize>(c: &[[f64; N]; 3]) -> [[f64; N]; 3
 /// Each lane clamped to `0..=1`, NaN to 0.
 #[inline(always)]
 fn clip_lanes<const N: usize>(c: &[[f64; N]; 3]) -> [[f64; N]; 3] {
-    c.map(|channel| channel.map(|v| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) }))
+    // Loops rather than `map`, which was copied through memory here.
+    let mut out = [[0.0; N]; 3];
+    for k in 0..3 {
+        for i in 0..N {
+            let v = c[k][i];
+            out[k][i] = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+        }
+    }
+    out
 }
 
 /// The Oklab distance between `a` and `b`, lane by lane.
@@ -718,27 +771,31 @@ fn reduce_chroma_lanes<const N: usize>(rgb: [[f64; N]; 3]) -> [[f64; N]; 3] {
         let current_rgb = oklab_to_linear_srgb_lanes(&current);
         let current_clipped = clip_lanes(&current_rgb);
         let e = delta_e_ok_lanes(&linear_srgb_to_oklab_lanes(&current_clipped), &current);
+        // Every lane's decision as selections (`&` on booleans, no early exit): branches on
+        // them would go one way or the other at random.
         for i in 0..N {
-            if !searching[i] {
-                continue;
-            }
-            let inside = (0..3).all(|k| (0.0..=1.0).contains(&current_rgb[k][i]));
-            if min_in_gamut[i] && inside {
-                min[i] = c[i];
-                continue;
-            }
+            let inside = (0..3).fold(true, |all, k| {
+                all & (0.0..=1.0).contains(&current_rgb[k][i])
+            });
+            let active = searching[i];
+            // Inside while nothing outside was accepted: only the lower bound moves.
+            let raise = min_in_gamut[i] & inside;
+            // Otherwise the clipped candidate is measured.
+            let measured = active & !raise;
+            let close = e[i] < JND;
             for k in 0..3 {
-                clipped[k][i] = current_clipped[k][i];
-            }
-            if e[i] < JND {
-                if JND - e[i] < EPSILON {
-                    searching[i] = false;
+                if measured {
+                    clipped[k][i] = current_clipped[k][i];
                 }
-                min_in_gamut[i] = false;
+            }
+            if active & (raise | close) {
                 min[i] = c[i];
-            } else {
+            }
+            if measured & !close {
                 max[i] = c[i];
             }
+            min_in_gamut[i] &= !(measured & close);
+            searching[i] = active & !(measured & close & (JND - e[i] < EPSILON));
         }
     }
     clipped
