@@ -370,11 +370,142 @@ impl RunConverter {
         }
         let mapped = self.gamut.apply_lanes(lin);
         for (&m, rgb) in indices.iter().zip(mapped) {
-            let encoded = match self.blend {
-                BlendSpace::Linear => rgb,
-                BlendSpace::Srgb => rgb.map(srgb_encode_fast),
-            };
-            out[usize::from(m)] = encoded.map(|v| v as f32);
+            out[usize::from(m)] = linear_to_blend_space_wide(rgb, self.blend);
+        }
+    }
+}
+
+/// A gamut-mapped linear-light colour in the blend space, in single precision: the end of
+/// [`to_blend_space_wide`].
+#[inline(always)]
+fn linear_to_blend_space_wide(rgb: [f64; 3], blend: BlendSpace) -> [f32; 3] {
+    let encoded = match blend {
+        BlendSpace::Linear => rgb,
+        BlendSpace::Srgb => rgb.map(srgb_encode_fast),
+    };
+    encoded.map(|v| v as f32)
+}
+
+/// [`to_blend_space_f32`], unless the colour needs the chroma search: then its linear-light
+/// colour, for [`WaitingColours`].
+#[inline(always)]
+pub(crate) fn to_blend_space_f32_or_outside(
+    space: ColourSpace,
+    c: [f32; 3],
+    gamut: GamutMapping,
+    blend: BlendSpace,
+) -> Result<[f32; 3], [f64; 3]> {
+    // sRGB in range, blended in sRGB (as the `vs_cairo` scene): inline, nothing to do.
+    if space == ColourSpace::Srgb && blend == BlendSpace::Srgb && in_unit(&c) {
+        return Ok(c);
+    }
+    to_blend_space_f32_or_outside_converted(space, c, gamut, blend)
+}
+
+/// [`to_blend_space_f32_or_outside`] when the colour needs converting.
+#[inline(never)]
+fn to_blend_space_f32_or_outside_converted(
+    space: ColourSpace,
+    c: [f32; 3],
+    gamut: GamutMapping,
+    blend: BlendSpace,
+) -> Result<[f32; 3], [f64; 3]> {
+    if gamut == GamutMapping::Clip || space == ColourSpace::Lab {
+        return Ok(to_blend_space_f32_converted(space, c, gamut, blend));
+    }
+    // As `to_blend_space_wide`, stopping before the gamut mapping.
+    let lin = space.to_linear_srgb(c.map(f64::from));
+    if in_gamut(lin, 0.0) {
+        Ok(linear_to_blend_space_wide(lin, blend))
+    } else {
+        Err(lin)
+    }
+}
+
+/// Colours of one layer's row waiting for the chroma search ([`to_blend_space_f32_or_outside`]),
+/// which takes them [`GAMUT_LANES`] at a time: the pixels' indices, linear-light colours and
+/// coverage. Room for a group and the colours of one more stretch of [`GAMUT_LANES`] pixels,
+/// so that the pixel loop need not test for room.
+pub(crate) struct WaitingColours {
+    pixel: [usize; 2 * GAMUT_LANES],
+    linear: [[f64; 3]; 2 * GAMUT_LANES],
+    alpha: [f32; 2 * GAMUT_LANES],
+    count: usize,
+}
+
+impl WaitingColours {
+    pub fn new() -> WaitingColours {
+        WaitingColours {
+            pixel: [0; 2 * GAMUT_LANES],
+            linear: [[0.0; 3]; 2 * GAMUT_LANES],
+            alpha: [0.0; 2 * GAMUT_LANES],
+            count: 0,
+        }
+    }
+
+    /// Adds a colour. At most [`GAMUT_LANES`] may be added between calls of
+    /// [`WaitingColours::map_group`].
+    #[inline(always)]
+    pub fn add(&mut self, pixel: usize, linear: [f64; 3], alpha: f32) {
+        let k = self.count;
+        (self.pixel[k], self.linear[k], self.alpha[k]) = (pixel, linear, alpha);
+        self.count += 1;
+    }
+
+    /// Maps a group of [`GAMUT_LANES`] colours, if that many wait, and hands each to
+    /// `put(pixel, colour in the blend space, alpha)`.
+    #[inline(always)]
+    pub fn map_group(
+        &mut self,
+        gamut: GamutMapping,
+        blend: BlendSpace,
+        mut put: impl FnMut(usize, [f32; 3], f32),
+    ) {
+        if self.count >= GAMUT_LANES {
+            self.finish_group::<GAMUT_LANES>(0, gamut, blend, &mut put);
+            let rest = GAMUT_LANES..self.count;
+            self.pixel.copy_within(rest.clone(), 0);
+            self.linear.copy_within(rest.clone(), 0);
+            self.alpha.copy_within(rest, 0);
+            self.count -= GAMUT_LANES;
+        }
+    }
+
+    /// Maps every colour still waiting, four at a time, as [`WaitingColours::map_group`].
+    #[inline(always)]
+    pub fn map_rest(
+        &mut self,
+        gamut: GamutMapping,
+        blend: BlendSpace,
+        mut put: impl FnMut(usize, [f32; 3], f32),
+    ) {
+        self.map_group(gamut, blend, &mut put);
+        for start in (0..self.count).step_by(4) {
+            self.finish_group::<4>(start, gamut, blend, &mut put);
+        }
+        self.count = 0;
+    }
+
+    /// Maps colours `start .. start + N` (those of them waiting).
+    #[inline(always)]
+    fn finish_group<const N: usize>(
+        &self,
+        start: usize,
+        gamut: GamutMapping,
+        blend: BlendSpace,
+        put: &mut impl FnMut(usize, [f32; 3], f32),
+    ) {
+        let end = (start + N).min(self.count);
+        // Unused lanes hold mid grey, which is inside and costs the search nothing.
+        let mut linear = [[0.5; 3]; N];
+        linear[..end - start].copy_from_slice(&self.linear[start..end]);
+        let mapped = gamut.apply_lanes(linear);
+        for (k, rgb) in (start..end).zip(mapped) {
+            put(
+                self.pixel[k],
+                linear_to_blend_space_wide(rgb, blend),
+                self.alpha[k],
+            );
         }
     }
 }
@@ -1101,6 +1232,72 @@ mod tests {
                 assert_eq!(s.map(f64::to_bits), l.map(f64::to_bits), "{c:?}");
                 let one = GamutMapping::Chroma.apply_lanes([*c]);
                 assert_eq!(s.map(f64::to_bits), one[0].map(f64::to_bits), "{c:?}");
+            }
+        }
+    }
+
+    /// Colours that wait for the chroma search ([`WaitingColours`]) come out as
+    /// [`to_blend_space_f32`] gives them one by one, bit for bit, whatever the stretches and
+    /// groups they wait in.
+    #[test]
+    fn waiting_colours_match_single_colours() {
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f32 / (1u64 << 53) as f32
+        };
+        for space in [
+            ColourSpace::Srgb,
+            ColourSpace::SrgbLinear,
+            ColourSpace::Oklab,
+        ] {
+            for blend in [BlendSpace::Srgb, BlendSpace::Linear] {
+                for gamut in [GamutMapping::Clip, GamutMapping::Chroma] {
+                    // Runs of colours inside and outside, so that groups fill unevenly.
+                    let colours: Vec<[f32; 3]> = (0..300)
+                        .map(|i| {
+                            let spread = if (i / 7) % 3 == 0 { 0.6 } else { 1.6 };
+                            let mut c = [0.0; 3].map(|_| spread * (next() - 0.5));
+                            if space != ColourSpace::Oklab {
+                                c = c.map(|v| v + 0.5);
+                            } else {
+                                c[0] = c[0].abs() + 0.3;
+                            }
+                            c
+                        })
+                        .collect();
+                    let mut out = vec![[f32::NAN; 3]; colours.len()];
+                    let mut waiting = WaitingColours::new();
+                    let mut outside = 0;
+                    let mut put = |k: usize, rgb: [f32; 3], alpha: f32| {
+                        assert_eq!(alpha, k as f32);
+                        assert!(out[k][0].is_nan(), "colour {k} handed over twice");
+                        out[k] = rgb;
+                    };
+                    for (start, stretch) in colours.chunks(GAMUT_LANES).enumerate() {
+                        for (i, &c) in stretch.iter().enumerate() {
+                            let k = start * GAMUT_LANES + i;
+                            match to_blend_space_f32_or_outside(space, c, gamut, blend) {
+                                Ok(rgb) => put(k, rgb, k as f32),
+                                Err(linear) => {
+                                    outside += 1;
+                                    waiting.add(k, linear, k as f32)
+                                }
+                            }
+                        }
+                        waiting.map_group(gamut, blend, &mut put);
+                    }
+                    waiting.map_rest(gamut, blend, &mut put);
+                    if gamut == GamutMapping::Chroma {
+                        assert!(outside > 3 * GAMUT_LANES, "{space:?}: {outside} outside");
+                    }
+                    for (k, (&c, o)) in colours.iter().zip(&out).enumerate() {
+                        let one = to_blend_space_f32(space, c, gamut, blend);
+                        assert_eq!(o.map(f32::to_bits), one.map(f32::to_bits), "{space:?} {k}");
+                    }
+                }
             }
         }
     }
