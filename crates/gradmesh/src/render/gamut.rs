@@ -901,18 +901,26 @@ fn reduce_chroma_lanes<const N: usize>(rgb: [[f64; N]; 3]) -> [[f64; N]; 3] {
         }
         let current_rgb = oklab_to_linear_srgb_lanes(&current);
         let current_clipped = clip_lanes(&current_rgb);
-        let e = delta_e_ok_lanes(&linear_srgb_to_oklab_lanes(&current_clipped), &current);
-        // Every lane's decision as selections (`&` on booleans, no early exit): branches on
-        // them would go one way or the other at random.
+        // Inside while nothing outside was accepted: only the lower bound moves. Otherwise
+        // the clipped candidate is measured; when no lane needs that (early steps, and most
+        // steps of a lone colour), the cube roots are skipped.
+        let mut measured = [false; N];
         for i in 0..N {
             let inside = (0..3).fold(true, |all, k| {
                 all & (0.0..=1.0).contains(&current_rgb[k][i])
             });
-            let active = searching[i];
-            // Inside while nothing outside was accepted: only the lower bound moves.
-            let raise = min_in_gamut[i] & inside;
-            // Otherwise the clipped candidate is measured.
-            let measured = active & !raise;
+            measured[i] = searching[i] & !(min_in_gamut[i] & inside);
+        }
+        let e = if measured.contains(&true) {
+            delta_e_ok_lanes(&linear_srgb_to_oklab_lanes(&current_clipped), &current)
+        } else {
+            [0.0; N]
+        };
+        // Every lane's decision as selections (`&` on booleans, no early exit): branches on
+        // them would go one way or the other at random.
+        for i in 0..N {
+            let (active, measured) = (searching[i], measured[i]);
+            let raise = active & !measured;
             let close = e[i] < JND;
             for k in 0..3 {
                 if measured {
