@@ -100,6 +100,10 @@ pub(crate) struct PreparedLayer {
     pub columns: (usize, usize),
     /// The colour bounds of a layer with quadratic triangles (see [`Bounds`]).
     pub bounds: Option<Bounds>,
+    /// Whether the colours of the control points the layer is drawn from (whose convex hull
+    /// holds every colour it shows, up to rounding) have all their channels in `0..=1`: in an
+    /// sRGB layer, hardly any pixel then needs gamut mapping.
+    pub colours_in_unit_range: bool,
 }
 
 /// The mesh with its colours converted to `space` (so that they are interpolated there).
@@ -774,6 +778,9 @@ pub(crate) fn prepare(
     if lines.is_empty() || columns.0 >= columns.1 {
         return Ok((info, None, warnings));
     }
+    let colours_in_unit_range = data.levels[k]
+        .iter()
+        .all(|d| d[2..5].iter().all(|c| (0.0..=1.0).contains(c)));
     let layer = PreparedLayer {
         space,
         triangles,
@@ -783,6 +790,7 @@ pub(crate) fn prepare(
         nearest,
         columns,
         bounds,
+        colours_in_unit_range,
     };
     Ok((info, Some(layer), warnings))
 }

@@ -786,6 +786,9 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
             converter: gamut::RunConverter::new(layer.space, opts.gamut, opts.blend, wide),
             gamut: opts.gamut,
             blend: opts.blend,
+            rarely_outside: layer.space == ColourSpace::Srgb
+                && opts.blend == BlendSpace::Srgb
+                && layer.colours_in_unit_range,
         };
         let bounds = layer.bounds.as_ref().unwrap_or(&triangles::UNBOUNDED);
         // Outline colours of a layer with quadratic sides are clamped as its triangles are.
@@ -992,6 +995,9 @@ struct Shading {
     converter: gamut::RunConverter,
     gamut: GamutMapping,
     blend: BlendSpace,
+    /// Whether colours outside the gamut are rare enough to be mapped one by one, in the
+    /// plain pixel loop (an sRGB layer blended in sRGB with colours in range).
+    rarely_outside: bool,
 }
 
 /// One row of a band's buffers, as a layer shades it.
@@ -1073,7 +1079,7 @@ fn shade_row<const FRESH: bool>(
         // Pixel by pixel: the other spaces have no vector path, and gathering them into runs
         // cost the sRGB `vs_cairo` scene 4 % more instructions.
         let (gamut, blend) = (shading.gamut, shading.blend);
-        if shading.space == ColourSpace::Srgb && blend == BlendSpace::Srgb {
+        if shading.rarely_outside {
             // Colours in range need nothing (SVG's, Cairo's), and the loop below cost the
             // `vs_cairo` scene 8 % more time.
             for i in cols {
