@@ -395,25 +395,24 @@ pub(crate) fn to_blend_space_f32_or_outside(
     gamut: GamutMapping,
     blend: BlendSpace,
 ) -> Result<[f32; 3], [f64; 3]> {
-    // sRGB in range, blended in sRGB (as the `vs_cairo` scene): inline, nothing to do.
-    if space == ColourSpace::Srgb && blend == BlendSpace::Srgb && in_unit(&c) {
-        return Ok(c);
+    if gamut == GamutMapping::Clip
+        || space == ColourSpace::Lab
+        || (space == ColourSpace::Srgb && blend == BlendSpace::Srgb && in_unit(&c))
+    {
+        return Ok(to_blend_space_f32(space, c, gamut, blend));
     }
-    to_blend_space_f32_or_outside_converted(space, c, gamut, blend)
+    converted_or_outside(space, c, blend)
 }
 
-/// [`to_blend_space_f32_or_outside`] when the colour needs converting.
+/// [`to_blend_space_wide`] of a colour of `space` (not Lab) under the chroma search, stopping
+/// before the search: the colour in the blend space if it lies inside the gamut, else its
+/// linear-light colour.
 #[inline(never)]
-fn to_blend_space_f32_or_outside_converted(
+fn converted_or_outside(
     space: ColourSpace,
     c: [f32; 3],
-    gamut: GamutMapping,
     blend: BlendSpace,
 ) -> Result<[f32; 3], [f64; 3]> {
-    if gamut == GamutMapping::Clip || space == ColourSpace::Lab {
-        return Ok(to_blend_space_f32_converted(space, c, gamut, blend));
-    }
-    // As `to_blend_space_wide`, stopping before the gamut mapping.
     let lin = space.to_linear_srgb(c.map(f64::from));
     if in_gamut(lin, 0.0) {
         Ok(linear_to_blend_space_wide(lin, blend))
