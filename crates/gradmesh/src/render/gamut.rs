@@ -1066,13 +1066,8 @@ mod tests {
     /// space, for colours inside and outside the gamut, and for partial runs.
     #[test]
     fn run_conversion_matches_single_colours() {
-        let mut seed = 0x853c_49e6_748f_ea9b_u64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f32 / (1u64 << 53) as f32
-        };
+        let mut bits = super::super::test_random(0x853c_49e6_748f_ea9b_u64);
+        let mut next = || (bits() >> 11) as f32 / (1u64 << 53) as f32;
         let spaces = [
             ColourSpace::Lab,
             ColourSpace::Srgb,
@@ -1248,13 +1243,8 @@ mod tests {
     /// groups they wait in.
     #[test]
     fn waiting_colours_match_single_colours() {
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f32 / (1u64 << 53) as f32
-        };
+        let mut bits = super::super::test_random(0x2545_f491_4f6c_dd1d_u64);
+        let mut next = || (bits() >> 11) as f32 / (1u64 << 53) as f32;
         for space in [
             ColourSpace::Srgb,
             ColourSpace::SrgbLinear,

@@ -1235,6 +1235,17 @@ mod tests {
     }
 }
 
+/// Deterministic pseudo-random numbers for tests: xorshift64 from `seed` (not zero).
+#[cfg(test)]
+pub(crate) fn test_random(mut seed: u64) -> impl FnMut() -> u64 {
+    move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed
+    }
+}
+
 #[cfg(test)]
 mod encode_tests {
     use super::*;

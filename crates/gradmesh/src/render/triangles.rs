@@ -689,13 +689,7 @@ mod tests {
 
     #[test]
     fn fast_floor_division_is_exact() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            seed
-        };
+        let mut next = super::super::test_random(0x9e37_79b9_7f4a_7c15);
         for _ in 0..200_000 {
             let r = next();
             // Numerators of every size up to 2^55, both signs; denominators 256 .. 2^35.
@@ -712,13 +706,8 @@ mod tests {
     #[test]
     fn narrow_and_wide_spans_agree() {
         // Awkward vertices, both orientations, rows through and beside them.
-        let mut seed = 0x2545_f491_u64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed % 20_000) as f64 / 37.0 - 20.0
-        };
+        let mut bits = super::super::test_random(0x2545_f491);
+        let mut next = || (bits() % 20_000) as f64 / 37.0 - 20.0;
         for _ in 0..2000 {
             let v = [0, 1, 2].map(|_| p(next(), next()));
             let Some(t) = Triangle::new(v, [[0.0; 2]; 3], [[0.0; 4]; 3]) else {
