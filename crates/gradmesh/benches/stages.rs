@@ -1,6 +1,7 @@
 //! One benchmark per stage of the pipeline, on the 10,092-face mesh of the `refine` bench:
 //! the ternary step, a Catmull-Clark step (topology and stencils, then applying them alone),
-//! limit evaluation (stencils and their application), and colour conversion of a large buffer.
+//! limit evaluation (stencils and their application), colour conversion of a large buffer, and
+//! CSS Color 4 gamut mapping of it (colour by colour and with `GamutMapping::apply_to_all`).
 //!
 //! Run: `cargo bench -p gradmesh --bench stages`.
 
