@@ -246,6 +246,14 @@ impl Stencils {
         stencils
     }
 
+    /// Reads source `s` from index `map[s]` of the data applied to instead. The terms keep
+    /// their order, so that the sums are the same bit for bit.
+    pub fn remap_sources(&mut self, map: &[u32]) {
+        for s in &mut self.sources {
+            *s = map[*s as usize];
+        }
+    }
+
     /// Appends the stencils of `other` after these.
     pub fn append(&mut self, other: &Stencils) {
         let base = *self.offsets.last().expect("offsets start with 0");
@@ -356,15 +364,10 @@ pub fn refine_level(parent: &Level) -> Level {
     }
 }
 
-/// Writes the data of the child vertices `vertices` of `parent` into `out` (indexed by child
-/// vertex; the others are left alone), bit for bit as [`refine`]'s stencils give it. For a
-/// face refined locally, whose next depth keeps a few of the child's faces.
-pub fn refine_data_at(
-    parent: &Level,
-    data: &[VertexData],
-    vertices: &[u32],
-    out: &mut [VertexData],
-) {
+/// The stencils of the child vertices `vertices` of `parent`, in that order: the rows of
+/// [`refine`]'s table for them, so that applied they give its data bit for bit. For a face
+/// refined locally, whose next depth keeps a few of the child's faces.
+pub fn refine_stencils_at(parent: &Level, vertices: &[u32]) -> Stencils {
     let terms = stencil_terms(parent);
     let mut stencils = Stencils::with_capacity(vertices.len(), 10 * vertices.len());
     let mut buffer = Vec::with_capacity(64);
@@ -372,9 +375,7 @@ pub fn refine_data_at(
         terms(v as usize, &mut buffer);
         stencils.push(&mut buffer);
     }
-    for (&v, value) in vertices.iter().zip(stencils.apply(data)) {
-        out[v as usize] = value;
-    }
+    stencils
 }
 
 /// The data of the child of `parent`: equal to `refine(parent).1.apply(data)`, bit for bit,

@@ -112,7 +112,7 @@ impl BoundaryInterpolation {
 }
 
 /// How the sharpness of semi-sharp edges decreases from one level to the next.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum CreasingMethod {
     /// Subtract one at each level.
     #[default]

@@ -35,7 +35,9 @@ use crate::validate::VertexData;
 
 use super::layer::{measure_quad, Measure, QuadSamples, Thresholds};
 use super::nearest::Segment;
-use super::patches::{regular_corners, regular_patch_with, ControlGrid, Grid, LocalPatch};
+use super::patches::{
+    regular_corners, regular_patch_with, ControlGrid, Grid, LocalPatch, ShapeCache,
+};
 use super::quadratic::{chord_node, measure_cells, screen_gradient, Cell, Quadratic};
 use super::triangles::{snap, Bounds, Triangle, TriangleList, UNBOUNDED};
 use super::view::ToPixels;
@@ -137,13 +139,19 @@ enum Source {
 }
 
 impl Source {
-    /// `regular`: whether each vertex of `level` is a regular corner ([`regular_corners`]).
-    fn new(level: &Level, regular: &[bool], data: &[VertexData], f: usize) -> Option<Source> {
+    /// `regular`: whether each vertex of `level` is a regular corner ([`regular_corners`]);
+    /// `shapes`: the layer's local refinements.
+    fn new(
+        level: &Level,
+        regular: &[bool],
+        data: &[VertexData],
+        f: usize,
+        shapes: &ShapeCache,
+    ) -> Option<Source> {
         match regular_patch_with(level, data, f, |v| regular[v]) {
             Some(cp) => Some(Source::Regular(cp)),
-            None => {
-                LocalPatch::new(level, data, &[f]).map(|patch| Source::Local { patch, root: 0 })
-            }
+            None => LocalPatch::new(level, data, &[f], shapes)
+                .map(|patch| Source::Local { patch, root: 0 }),
         }
     }
 
@@ -412,6 +420,7 @@ pub(super) fn tessellate(
         |f: usize| -> [bool; 4] { each4(|k| t.is_boundary_edge(t.face_edges(f)[k] as usize)) };
 
     let regular = regular_corners(level);
+    let shapes = ShapeCache::default();
 
     // 1. The density of each face.
     let orders = CellOrders::new(n_max.max(1) * 2);
@@ -569,13 +578,15 @@ pub(super) fn tessellate(
     let each_alone = |group: &[(usize, usize)]| -> Option<Vec<(usize, Plan)>> {
         group
             .iter()
-            .map(|&(_, f)| plan_face(f, &mut Source::new(level, &regular, d, f)?).map(|p| (f, p)))
+            .map(|&(_, f)| {
+                plan_face(f, &mut Source::new(level, &regular, d, f, &shapes)?).map(|p| (f, p))
+            })
             .collect()
     };
     let together = |group: &[(usize, usize)]| -> Option<Vec<(usize, Plan)>> {
         let faces: Vec<usize> = group.iter().map(|&(_, f)| f).collect();
         let mut src = Source::Local {
-            patch: LocalPatch::new(level, d, &faces)?,
+            patch: LocalPatch::new(level, d, &faces, &shapes)?,
             root: 0,
         };
         let mut planned = Vec::with_capacity(faces.len());
@@ -650,7 +661,7 @@ pub(super) fn tessellate(
                 plan.n.max(finest_edge / 2)
             };
             if n != plan.n {
-                let mut src = Source::new(level, &regular, d, f)?;
+                let mut src = Source::new(level, &regular, d, f, &shapes)?;
                 plan.grid = src.grid(n)?;
                 // A quadratic face refined further for its neighbours' sake is often fine
                 // enough for linear pieces, which need no grid of twice the count for their
@@ -686,7 +697,7 @@ pub(super) fn tessellate(
         if plans[f].n == 1 && finer {
             match plans[f].centre {
                 Some(c) => Some(Some(c)),
-                None => Source::new(level, &regular, d, f)?
+                None => Source::new(level, &regular, d, f, &shapes)?
                     .grid(2)
                     .map(|g| Some(g[4])),
             }

@@ -14,9 +14,12 @@
 //! sharpness, determine its whole limit surface, so refining that small mesh and applying the
 //! limit stencils gives the same grid as refining the whole layer would.
 
-use crate::catmull_clark::{self, Level};
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
+
+use crate::catmull_clark::{self, Level, Stencils};
 use crate::limit;
-use crate::mesh::BoundaryInterpolation;
+use crate::mesh::{BoundaryInterpolation, CreasingMethod};
 use crate::rules::{self, VertexRule};
 use crate::topology::Topology;
 use crate::validate::VertexData;
@@ -30,6 +33,10 @@ pub(crate) type Grid = Vec<VertexData>;
 /// The 16 control points of a regular patch: `cp[j][i]`, `i` along `u`, `j` along `v`; the
 /// face's corners are `cp[1][1]`, `cp[1][2]`, `cp[2][2]` and `cp[2][1]`.
 pub(crate) type ControlGrid = [[VertexData; 4]; 4];
+
+/// The vertices of a regular patch's control grid, as [`ControlGrid`] places them; `None`
+/// where a phantom point lies beyond a boundary.
+type PatchPoints = [[Option<u32>; 4]; 4];
 
 /// Where corner `c` of the face sits in the control grid, as `(i, j)`.
 const GRID_CORNERS: [(isize, isize); 4] = [(1, 1), (2, 1), (2, 2), (1, 2)];
@@ -159,12 +166,24 @@ pub(crate) fn regular_patch_with(
     f: usize,
     regular: impl Fn(usize) -> bool,
 ) -> Option<ControlGrid> {
+    regular_patch_points(level, f, regular)
+        .map(|points| control_grid(&points, |v| data[v as usize]))
+}
+
+/// The vertices of `level` at the places of a [`regular_patch`]'s control grid (`None` for the
+/// phantoms beyond a boundary), if face `f`'s limit surface is one: which it is, and where
+/// its points are, depends on the topology alone.
+fn regular_patch_points(
+    level: &Level,
+    f: usize,
+    regular: impl Fn(usize) -> bool,
+) -> Option<PatchPoints> {
     let t = &level.topology;
     let fv = t.face_vertices(f);
     if fv.len() != 4 {
         return None;
     }
-    let mut index: [[Option<u32>; 4]; 4] = [[None; 4]; 4];
+    let mut index: PatchPoints = [[None; 4]; 4];
     // Each outer point is reached from two corners: both must agree.
     let mut put = |(i, j): (isize, isize), v: u32| -> bool {
         let slot = &mut index[j as usize][i as usize];
@@ -215,12 +234,18 @@ pub(crate) fn regular_patch_with(
             }
         }
     }
+    Some(index)
+}
+
+/// The control grid of a regular patch whose points are `points` ([`regular_patch_points`]),
+/// reading the data of point `v` as `data(v)`, with the phantoms reflected.
+fn control_grid(points: &PatchPoints, data: impl Fn(u32) -> VertexData) -> ControlGrid {
     let mut cp = [[[0.0; 6]; 4]; 4];
     let mut real = [[false; 4]; 4];
     for j in 0..4 {
         for i in 0..4 {
-            if let Some(v) = index[j][i] {
-                cp[j][i] = data[v as usize];
+            if let Some(v) = points[j][i] {
+                cp[j][i] = data(v);
                 real[j][i] = true;
             }
         }
@@ -261,7 +286,7 @@ pub(crate) fn regular_patch_with(
             reflect(cp[j][i1], cp[j][i2])
         };
     }
-    Some(cp)
+    cp
 }
 
 /// One quad of a locally refined face at some depth: its index in that level, the face it
@@ -304,19 +329,75 @@ impl Tile {
     }
 }
 
-/// One depth of a locally refined face.
-struct LocalLevel {
+/// One depth of a neighbourhood's local refinement, as far as it depends on the topology
+/// alone. Every neighbourhood cut out the same way shares it ([`ShapeCache`]); each keeps its
+/// own data, as rows ([`LocalPatch`]).
+struct ShapeDepth {
     /// The faces around `tiles`, as their own mesh (`None` when no tile is left).
-    local: Option<(Level, Vec<VertexData>)>,
+    local: Option<Level>,
+    /// The row of this depth's data that holds each vertex of `local`.
+    local_rows: Vec<u32>,
+    /// This depth's rows from the last depth's (`None` at depth 0, whose rows are the
+    /// cut-out vertices' own data, in `local`'s order).
+    refine: Option<Stencils>,
     /// The faces' descendants at this depth that are refined further.
     tiles: Vec<Tile>,
-    /// Their descendants at this depth whose limit surface is a B-spline patch: evaluated
-    /// directly, never refined.
-    patches: Vec<(Tile, ControlGrid)>,
-    /// The limit points of the corners of `tiles`, once asked for: a slot per vertex of
-    /// `local` (`u32::MAX` for none) and the points.
-    corner_limits: Option<(Vec<u32>, Vec<VertexData>)>,
+    /// Their descendants at this depth whose limit surface is a B-spline patch, with the
+    /// rows of its points: evaluated directly, never refined.
+    patches: Vec<(Tile, PatchPoints)>,
+    /// The limit stencils of the corners of `tiles` over this depth's rows, with a slot per
+    /// vertex of `local` (`u32::MAX` for none), once asked for (`None` if they fail).
+    corner_limits: OnceLock<Option<(Vec<u32>, Stencils)>>,
 }
+
+/// The local refinement of one shape of neighbourhood, deepened as far as some face asks.
+struct LocalShape {
+    /// The depths built so far, and whether the next one failed (its faces did not form a
+    /// valid mesh on their own).
+    depths: Mutex<(Vec<Arc<ShapeDepth>>, bool)>,
+}
+
+impl LocalShape {
+    /// Depth `d`, built with those above it if need be; `None` if that failed.
+    fn depth(&self, d: usize) -> Option<Arc<ShapeDepth>> {
+        let mut guard = self.depths.lock().unwrap_or_else(|e| e.into_inner());
+        let (depths, failed) = &mut *guard;
+        while depths.len() <= d {
+            if *failed {
+                return None;
+            }
+            match deepen(depths.last().expect("depth 0")) {
+                Some(next) => depths.push(Arc::new(next)),
+                None => {
+                    *failed = true;
+                    return None;
+                }
+            }
+        }
+        Some(Arc::clone(&depths[d]))
+    }
+}
+
+/// What determines a neighbourhood's local refinement: the cut-out mesh (vertex count,
+/// faces), the sharpness of each corner's edge and of each vertex (as bits), the creasing
+/// method, and which local faces are refined (in root order).
+#[derive(PartialEq, Eq, Hash)]
+struct ShapeKey {
+    vertex_count: usize,
+    offsets: Vec<u32>,
+    corners: Vec<u32>,
+    edge_sharpness: Vec<u64>,
+    vertex_sharpness: Vec<u64>,
+    creasing: CreasingMethod,
+    roots: Vec<u32>,
+}
+
+/// The shapes of neighbourhood one layer's faces have been refined in. The structure of local
+/// refinement (topology, stencils, which descendants are patches) is most of its cost, and
+/// the neighbourhoods of a layer's extraordinary vertices often have the same shape: Glasses
+/// cuts out 96 neighbourhoods of about 35 shapes at 1024 px.
+#[derive(Default)]
+pub(crate) struct ShapeCache(Mutex<HashMap<ShapeKey, Option<Arc<LocalShape>>>>);
 
 /// Faces refined on their own, feature-adaptively: at each depth the descendants that have
 /// become regular patches are set aside, and only the faces around the others (which
@@ -328,14 +409,19 @@ struct LocalLevel {
 /// together, they share the work (their neighbourhoods together are about three faces', not
 /// one per face).
 pub(crate) struct LocalPatch {
-    levels: Vec<LocalLevel>,
+    shape: Arc<LocalShape>,
+    /// The depths of `shape` used so far: a snapshot, read without the lock.
+    depths: Vec<Arc<ShapeDepth>>,
+    /// This neighbourhood's data at each depth (see [`ShapeDepth`]).
+    rows: Vec<Vec<VertexData>>,
+    /// The limit points of each depth's tile corners, once asked for.
+    corner_limits: Vec<Option<Vec<VertexData>>>,
 }
 
-/// The faces `keep` (sorted) of `level` (with data `data`) as a mesh of their own, in which
-/// kept face `k` is face `k` ([`local_face`]). The cut around them becomes a boundary
-/// (infinitely sharp): it changes only points that the kept faces' inner limit surface does not
-/// depend on.
-fn extract(level: &Level, data: &[VertexData], keep: &[u32]) -> Option<(Level, Vec<VertexData>)> {
+/// The faces `keep` (sorted) of `level` as a mesh of their own, in which kept face `k` is face
+/// `k` ([`local_face`]): its vertices (as indices of `level`, in their local order), face
+/// offsets and corners.
+fn cut_out(level: &Level, keep: &[u32]) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
     let t = &level.topology;
     let mut vertices: Vec<u32> = Vec::new();
     // Flat, as the topology keeps them: a list per face cost an allocation per face.
@@ -361,6 +447,19 @@ fn extract(level: &Level, data: &[VertexData], keep: &[u32]) -> Option<(Level, V
             vertex_map[v as usize] = u32::MAX;
         }
     });
+    (vertices, offsets, corners)
+}
+
+/// The mesh [`cut_out`] of `level` (`vertices`, `offsets`, `corners`), with its sharpness. The
+/// cut around it becomes a boundary (infinitely sharp): it changes only points that the kept
+/// faces' inner limit surface does not depend on. `None` if it is not a valid mesh.
+fn local_level(
+    level: &Level,
+    vertices: &[u32],
+    offsets: Vec<u32>,
+    corners: Vec<u32>,
+) -> Option<Level> {
+    let t = &level.topology;
     let topology = Topology::build(vertices.len(), offsets, corners, |_, _| false).ok()?;
     let edge_sharpness = (0..topology.edge_count())
         .map(|e| {
@@ -376,19 +475,17 @@ fn extract(level: &Level, data: &[VertexData], keep: &[u32]) -> Option<(Level, V
         .iter()
         .map(|&v| level.vertex_sharpness[v as usize])
         .collect();
-    let local = Level::new(
+    Some(Level::new(
         topology,
         edge_sharpness,
         vertex_sharpness,
         level.creasing,
         BoundaryInterpolation::EdgeOnly,
-    );
-    let local_data = vertices.iter().map(|&v| data[v as usize]).collect();
-    Some((local, local_data))
+    ))
 }
 
 thread_local! {
-    /// [`extract`]'s map from a level's vertices to the neighbourhood's, all `u32::MAX`
+    /// [`cut_out`]'s map from a level's vertices to the neighbourhood's, all `u32::MAX`
     /// between calls: allocated once per thread, so that cutting a face's neighbourhood out of
     /// a large level costs the neighbourhood's size, not the level's (it was two arrays the
     /// size of the whole level per irregular face).
@@ -426,11 +523,82 @@ fn neighbourhood(t: &Topology, tiles: &[Tile]) -> Vec<u32> {
     faces
 }
 
+/// The depth below `last` (which has tiles left): its children that are regular patches are
+/// set aside, and the faces around the others kept. `None` if those do not form a valid mesh.
+fn deepen(last: &ShapeDepth) -> Option<ShapeDepth> {
+    let last_level = last.local.as_ref().expect("a depth with tiles has a mesh");
+    let child = catmull_clark::refine_level(last_level);
+    let mut tiles = Vec::with_capacity(4 * last.tiles.len());
+    for tile in &last.tiles {
+        tiles.extend(tile.children(last_level.topology.face_offset(tile.face as usize)));
+    }
+    // Rows only for the vertices of the faces around the children, where their patches'
+    // control points and the next depth's neighbourhood lie: about half of the child's.
+    let ct = &child.topology;
+    let mut wanted = vec![false; ct.vertex_count()];
+    for f in neighbourhood(ct, &tiles) {
+        for &v in ct.face_vertices(f as usize) {
+            wanted[v as usize] = true;
+        }
+    }
+    let wanted: Vec<u32> = (0..ct.vertex_count() as u32)
+        .filter(|&v| wanted[v as usize])
+        .collect();
+    let mut row_of = vec![u32::MAX; ct.vertex_count()];
+    for (r, &v) in wanted.iter().enumerate() {
+        row_of[v as usize] = r as u32;
+    }
+    let mut refine = catmull_clark::refine_stencils_at(last_level, &wanted);
+    refine.remap_sources(&last.local_rows);
+    let mut patches = Vec::new();
+    tiles.retain(|tile| {
+        let face = tile.face as usize;
+        match regular_patch_points(&child, face, |v| regular_corner(&child, v)) {
+            Some(points) => {
+                patches.push((
+                    *tile,
+                    points.map(|row| row.map(|v| v.map(|v| row_of[v as usize]))),
+                ));
+                false
+            }
+            None => true,
+        }
+    });
+    let (local, local_rows) = if tiles.is_empty() {
+        (None, Vec::new())
+    } else {
+        let keep = neighbourhood(ct, &tiles);
+        let (vertices, offsets, corners) = cut_out(&child, &keep);
+        let local = local_level(&child, &vertices, offsets, corners)?;
+        for tile in &mut tiles {
+            tile.face = local_face(&keep, tile.face);
+        }
+        (
+            Some(local),
+            vertices.iter().map(|&v| row_of[v as usize]).collect(),
+        )
+    };
+    Some(ShapeDepth {
+        local,
+        local_rows,
+        refine: Some(refine),
+        tiles,
+        patches,
+        corner_limits: OnceLock::new(),
+    })
+}
+
 impl LocalPatch {
-    /// Extracts the neighbourhood of the faces `faces` of `level` (their roots are their
-    /// indices in `faces`); `None` if one is not a quad or the neighbourhood does not form a
-    /// valid mesh on its own.
-    pub fn new(level: &Level, data: &[VertexData], faces: &[usize]) -> Option<LocalPatch> {
+    /// Cuts out the neighbourhood of the faces `faces` of `level` (their roots are their
+    /// indices in `faces`), whose refinement is shared through `cache` with those of the same
+    /// shape; `None` if one is not a quad or the neighbourhood does not form a valid mesh on
+    /// its own.
+    pub fn new(
+        level: &Level,
+        data: &[VertexData],
+        faces: &[usize],
+        cache: &ShapeCache,
+    ) -> Option<LocalPatch> {
         let t = &level.topology;
         if faces.iter().any(|&f| t.face_vertices(f).len() != 4) {
             return None;
@@ -447,73 +615,76 @@ impl LocalPatch {
             })
             .collect();
         let keep = neighbourhood(t, &tiles);
-        let (local, local_data) = extract(level, data, &keep)?;
+        let (vertices, offsets, corners) = cut_out(level, &keep);
         for tile in &mut tiles {
             tile.face = local_face(&keep, tile.face);
         }
+        let key = ShapeKey {
+            vertex_count: vertices.len(),
+            edge_sharpness: keep
+                .iter()
+                .flat_map(|&g| t.face_edges(g as usize))
+                .map(|&e| level.edge_sharpness[e as usize].to_bits())
+                .collect(),
+            vertex_sharpness: vertices
+                .iter()
+                .map(|&v| level.vertex_sharpness[v as usize].to_bits())
+                .collect(),
+            creasing: level.creasing,
+            roots: tiles.iter().map(|tile| tile.face).collect(),
+            offsets,
+            corners,
+        };
+        let shape = {
+            let mut shapes = cache.0.lock().unwrap_or_else(|e| e.into_inner());
+            match shapes.get(&key) {
+                Some(shape) => shape.clone(),
+                None => {
+                    let local =
+                        local_level(level, &vertices, key.offsets.clone(), key.corners.clone());
+                    let shape = local.map(|local| {
+                        Arc::new(LocalShape {
+                            depths: Mutex::new((
+                                vec![Arc::new(ShapeDepth {
+                                    local: Some(local),
+                                    local_rows: (0..vertices.len() as u32).collect(),
+                                    refine: None,
+                                    tiles,
+                                    patches: Vec::new(),
+                                    corner_limits: OnceLock::new(),
+                                })],
+                                false,
+                            )),
+                        })
+                    });
+                    shapes.insert(key, shape.clone());
+                    shape
+                }
+            }
+        }?;
+        let first = shape.depth(0)?;
         Some(LocalPatch {
-            levels: vec![LocalLevel {
-                local: Some((local, local_data)),
-                tiles,
-                patches: Vec::new(),
-                corner_limits: None,
-            }],
+            shape,
+            depths: vec![first],
+            rows: vec![vertices.iter().map(|&v| data[v as usize]).collect()],
+            corner_limits: vec![None],
         })
     }
 
-    /// Refines the last depth once: children that are regular patches are set aside, and the
-    /// faces around the others kept.
-    fn deepen(&mut self) -> Option<()> {
-        let last = self.levels.last().expect("depth 0");
-        let Some((last_level, last_data)) = &last.local else {
-            return Some(());
-        };
-        let child = catmull_clark::refine_level(last_level);
-        let mut tiles = Vec::with_capacity(4 * last.tiles.len());
-        for tile in &last.tiles {
-            tiles.extend(tile.children(last_level.topology.face_offset(tile.face as usize)));
+    /// Refines this neighbourhood's data down to `depth`, or as far as tiles are left;
+    /// `None` if the shape cannot be refined that far.
+    fn reach(&mut self, depth: usize) -> Option<()> {
+        while self.depths.len() <= depth && !self.depths.last().expect("depth 0").tiles.is_empty() {
+            let next = self.shape.depth(self.depths.len())?;
+            let rows = next
+                .refine
+                .as_ref()
+                .expect("below depth 0")
+                .apply(self.rows.last().expect("depth 0"));
+            self.depths.push(next);
+            self.rows.push(rows);
+            self.corner_limits.push(None);
         }
-        // Data only for the vertices of the faces around the children, where their patches'
-        // control points and the next depth's neighbourhood lie: about half of the child's.
-        let ct = &child.topology;
-        let mut wanted = vec![false; ct.vertex_count()];
-        for f in neighbourhood(ct, &tiles) {
-            for &v in ct.face_vertices(f as usize) {
-                wanted[v as usize] = true;
-            }
-        }
-        let wanted: Vec<u32> = (0..ct.vertex_count() as u32)
-            .filter(|&v| wanted[v as usize])
-            .collect();
-        let mut child_data = vec![[0.0; 6]; ct.vertex_count()];
-        catmull_clark::refine_data_at(last_level, last_data, &wanted, &mut child_data);
-        let mut patches = Vec::new();
-        tiles.retain(|tile| {
-            let face = tile.face as usize;
-            match regular_patch_with(&child, &child_data, face, |v| regular_corner(&child, v)) {
-                Some(cp) => {
-                    patches.push((*tile, cp));
-                    false
-                }
-                None => true,
-            }
-        });
-        let local = if tiles.is_empty() {
-            None
-        } else {
-            let keep = neighbourhood(&child.topology, &tiles);
-            let local = extract(&child, &child_data, &keep)?;
-            for tile in &mut tiles {
-                tile.face = local_face(&keep, tile.face);
-            }
-            Some(local)
-        };
-        self.levels.push(LocalLevel {
-            local,
-            tiles,
-            patches,
-            corner_limits: None,
-        });
         Some(())
     }
 
@@ -522,18 +693,23 @@ impl LocalPatch {
     /// corners of the descendants still refined at that depth at their limit positions.
     pub fn grid(&mut self, root: usize, n: usize) -> Option<Grid> {
         let depth = n.trailing_zeros() as usize;
-        while self.levels.len() <= depth && !self.levels.last().expect("depth 0").tiles.is_empty() {
-            self.deepen()?;
-        }
+        self.reach(depth)?;
         let root = root as u32;
         let stride = n as i64 + 1;
         let mut grid = vec![[0.0; 6]; (n + 1) * (n + 1)];
-        for (d, at) in self.levels.iter().enumerate().take(depth + 1) {
+        for (d, (at, rows)) in self
+            .depths
+            .iter()
+            .zip(&self.rows)
+            .enumerate()
+            .take(depth + 1)
+        {
             // A tile of depth `d` spans `m` cells of the grid.
             let m = 1i64 << (depth - d);
-            for (tile, cp) in at.patches.iter().filter(|(tile, _)| tile.root == root) {
+            for (tile, points) in at.patches.iter().filter(|(tile, _)| tile.root == root) {
+                let cp = control_grid(points, |r| rows[r as usize]);
                 let o = [tile.origin[0] * m, tile.origin[1] * m];
-                evaluate_patch_with(cp, m as usize, |i, j, p| {
+                evaluate_patch_with(&cp, m as usize, |i, j, p| {
                     let (i, j) = (i as i64, j as i64);
                     let x = o[0] + i * tile.u[0] + j * tile.v[0];
                     let y = o[1] + i * tile.u[1] + j * tile.v[1];
@@ -541,34 +717,36 @@ impl LocalPatch {
                 });
             }
         }
-        let Some(LocalLevel {
-            local: Some((level, data)),
-            tiles,
-            corner_limits,
-            ..
-        }) = self.levels.get_mut(depth)
-        else {
+        let Some(at) = self.depths.get(depth) else {
+            return Some(grid);
+        };
+        let Some(level) = &at.local else {
             return Some(grid);
         };
         let t = &level.topology;
-        if corner_limits.is_none() {
-            // The limit points of the tiles' corners only (the ring around them is most of
-            // the local level), each once, for every face refined together.
-            let mut slot = vec![u32::MAX; t.vertex_count()];
-            let mut wanted = Vec::with_capacity(4 * tiles.len());
-            for tile in tiles.iter() {
-                for &v in t.face_vertices(tile.face as usize) {
-                    if slot[v as usize] == u32::MAX {
-                        slot[v as usize] = wanted.len() as u32;
-                        wanted.push(v);
+        // The limit points of the tiles' corners only (the ring around them is most of the
+        // local level), each once, for every face refined together.
+        let (slot, stencils) = at
+            .corner_limits
+            .get_or_init(|| {
+                let mut slot = vec![u32::MAX; t.vertex_count()];
+                let mut wanted = Vec::with_capacity(4 * at.tiles.len());
+                for tile in &at.tiles {
+                    for &v in t.face_vertices(tile.face as usize) {
+                        if slot[v as usize] == u32::MAX {
+                            slot[v as usize] = wanted.len() as u32;
+                            wanted.push(v);
+                        }
                     }
                 }
-            }
-            let limits = limit::limit_stencils_for(level, &wanted)?.apply(data);
-            *corner_limits = Some((slot, limits));
-        }
-        let (slot, limits) = corner_limits.as_ref().expect("just computed");
-        for tile in tiles.iter().filter(|tile| tile.root == root) {
+                let mut stencils = limit::limit_stencils_for(level, &wanted)?;
+                stencils.remap_sources(&at.local_rows);
+                Some((slot, stencils))
+            })
+            .as_ref()?;
+        let limits =
+            self.corner_limits[depth].get_or_insert_with(|| stencils.apply(&self.rows[depth]));
+        for tile in at.tiles.iter().filter(|tile| tile.root == root) {
             let o = tile.origin;
             let corners = [
                 o,
@@ -688,7 +866,7 @@ mod tests {
         // Local refinement of face 0 (an irregular face) equals refining the whole mesh: two
         // levels down.
         assert!(t.face_vertices(0).contains(&centre));
-        let mut local = LocalPatch::new(&level, &data, &[0]).unwrap();
+        let mut local = LocalPatch::new(&level, &data, &[0], &ShapeCache::default()).unwrap();
         let g = local.grid(0, 4).unwrap();
         let (l1, s1) = refine(&level);
         let (l2, s2) = refine(&l1);
@@ -708,7 +886,7 @@ mod tests {
             .find(|&f| regular_patch(&level, &data, f).is_some())
             .expect("a regular face");
         let cp = regular_patch(&level, &data, regular).unwrap();
-        let a = LocalPatch::new(&level, &data, &[regular])
+        let a = LocalPatch::new(&level, &data, &[regular], &ShapeCache::default())
             .unwrap()
             .grid(0, 4)
             .unwrap();
@@ -763,7 +941,7 @@ mod tests {
     /// Checks face `f`'s local grids of 1 to 16 cells against the whole mesh's, and returns
     /// how many patches its local refinement set aside.
     fn check_local_grids(level: &Level, data: &[VertexData], f: usize) -> usize {
-        let mut local = LocalPatch::new(level, data, &[f]).unwrap();
+        let mut local = LocalPatch::new(level, data, &[f], &ShapeCache::default()).unwrap();
         for n in [1, 2, 4, 8, 16, 4] {
             let expected = whole_mesh_grid(level, data, f, n);
             let got = local.grid(0, n).unwrap();
@@ -774,7 +952,7 @@ mod tests {
                 );
             }
         }
-        local.levels.iter().map(|l| l.patches.len()).sum()
+        local.depths.iter().map(|l| l.patches.len()).sum()
     }
 
     #[test]
@@ -827,7 +1005,7 @@ mod tests {
         // The five faces around a valence-5 vertex, asked for in any order and at any count.
         let (level, data) = star_level();
         let around = faces_around_valence_5(&level);
-        let mut group = LocalPatch::new(&level, &data, &around).unwrap();
+        let mut group = LocalPatch::new(&level, &data, &around, &ShapeCache::default()).unwrap();
         for (root, n) in [
             (0, 1),
             (2, 4),
@@ -847,6 +1025,29 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn neighbourhoods_of_one_shape_share_their_refinement_not_their_data() {
+        let (level, data) = star_level();
+        let around = faces_around_valence_5(&level);
+        let other: Vec<VertexData> = data.iter().map(|d| d.map(|x| 2.0 * x + 1.0)).collect();
+        let shared = ShapeCache::default();
+        // The first asks for depth 4 before the second has anything; the second then needs
+        // depths the first built, and one it did not.
+        let mut a = LocalPatch::new(&level, &data, &around, &shared).unwrap();
+        let first = a.grid(1, 16).unwrap();
+        let mut b = LocalPatch::new(&level, &other, &around, &shared).unwrap();
+        let second = [b.grid(3, 4).unwrap(), b.grid(2, 32).unwrap()];
+        assert_eq!(shared.0.lock().unwrap().len(), 1, "one shape");
+        let alone = |data: &[VertexData], root: usize, n: usize| {
+            let mut patch = LocalPatch::new(&level, data, &around, &ShapeCache::default()).unwrap();
+            patch.grid(root, n).unwrap()
+        };
+        assert_eq!(first, alone(&data, 1, 16));
+        assert_eq!(second[0], alone(&other, 3, 4));
+        assert_eq!(second[1], alone(&other, 2, 32));
+        assert_ne!(first, alone(&other, 1, 16));
     }
 
     /// The faces of `level` around its vertex of valence 5.
