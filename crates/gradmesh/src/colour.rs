@@ -166,7 +166,8 @@ fn srgb_decode_slope(encoded: f64) -> f64 {
 /// does not matter and `pow` and `cbrt` cost more than the rest of the measure.
 struct Table {
     lo: f64,
-    step: f64,
+    /// Samples per unit of `x`: a multiplication per look-up rather than a division.
+    per_unit: f64,
     values: Vec<f64>,
 }
 
@@ -177,7 +178,7 @@ impl Table {
         let step = (hi - lo) / Self::SAMPLES as f64;
         Table {
             lo,
-            step,
+            per_unit: 1.0 / step,
             values: (0..=Self::SAMPLES)
                 .map(|k| f(lo + k as f64 * step))
                 .collect(),
@@ -187,7 +188,7 @@ impl Table {
     /// The interpolated value at `x`, or `None` outside the table.
     #[inline]
     fn at(&self, x: f64) -> Option<f64> {
-        let u = (x - self.lo) / self.step;
+        let u = (x - self.lo) * self.per_unit;
         if !(0.0..Self::SAMPLES as f64).contains(&u) {
             return None;
         }

@@ -276,7 +276,9 @@ impl CellOrders {
 /// Measures a face's grid of `n` cells a side against its grid of `2 n` (whose even samples
 /// are the same points). `boundary[k]`: whether side `k` of the face lies on the outline.
 /// `counted` receives, per cell, whether its colour counted (it reaches the image and is not
-/// too small to matter, see [`measure_quad`]).
+/// too small to matter, see [`measure_quad`]); `jacobians`, in spaces whose distances are not
+/// Lab's, the derivative to Lab at each point of the finer grid with an odd coordinate (the
+/// others are never asked for), which the quadratic measure reads at the cells' centres.
 #[allow(clippy::too_many_arguments)]
 fn measure_grid(
     g: &[VertexData],
@@ -287,6 +289,7 @@ fn measure_grid(
     xf: &ToPixels,
     th: &Thresholds,
     counted: &mut Vec<bool>,
+    jacobians: &mut Vec<Matrix3>,
 ) -> Measure {
     let (s1, s2) = (n + 1, 2 * n + 1);
     let at = |(i, j): (usize, usize)| &g[j * s1 + i];
@@ -299,23 +302,18 @@ fn measure_grid(
             || (a.1 == n && b.1 == n && boundary[2])
             || (a.0 == 0 && b.0 == 0 && boundary[3])
     };
-    // Spaces whose distances are not Lab's measure through the derivative at each sample: one conversion per sample instead of two per comparison. The samples are
-    // the points of the finer grid with an odd coordinate; the others are never asked for.
-    let jacobians: Option<Vec<Matrix3>> = matches!(
-        th.space,
-        ColourSpace::Srgb | ColourSpace::SrgbLinear | ColourSpace::Oklab
-    )
-    .then(|| {
-        g2.iter()
-            .enumerate()
-            .map(|(k, d)| {
-                if (k % s2) % 2 == 0 && (k / s2) % 2 == 0 {
-                    Matrix3::default()
-                } else {
-                    th.space.lab_jacobian([d[2], d[3], d[4]])
-                }
-            })
-            .collect()
+    // Spaces whose distances are not Lab's measure through the derivative at each sample: one
+    // conversion per sample instead of two per comparison.
+    jacobians.clear();
+    let jacobians = needs_jacobians(th.space).then(|| {
+        jacobians.extend(g2.iter().enumerate().map(|(k, d)| {
+            if (k % s2) % 2 == 0 && (k / s2) % 2 == 0 {
+                Matrix3::default()
+            } else {
+                th.space.lab_jacobian([d[2], d[3], d[4]])
+            }
+        }));
+        &jacobians[..]
     });
     let jac = |a: (usize, usize), b: (usize, usize)| {
         jacobians.as_ref().map(|j| &j[(a.1 + b.1) * s2 + a.0 + b.0])
@@ -342,6 +340,14 @@ fn measure_grid(
         m = m.max(cell);
     }
     m
+}
+
+/// Whether colour errors in `space` are measured through the derivative to Lab.
+fn needs_jacobians(space: ColourSpace) -> bool {
+    matches!(
+        space,
+        ColourSpace::Srgb | ColourSpace::SrgbLinear | ColourSpace::Oklab
+    )
 }
 
 /// How a face's cells interpolate colour.
@@ -454,7 +460,7 @@ pub(super) fn tessellate(
         }
         let boundary = boundary_sides(f);
         let (mut last_colour, mut last_quadratic): (Option<f64>, Option<f64>) = (None, None);
-        let mut counted = Vec::new();
+        let (mut counted, mut jacobians) = (Vec::new(), Vec::new());
         loop {
             if plan.n >= n_max {
                 plan.capped = true;
@@ -473,6 +479,7 @@ pub(super) fn tessellate(
                 xf,
                 th,
                 &mut counted,
+                &mut jacobians,
             );
             if passes(&m) {
                 plan.measured = m;
@@ -500,6 +507,7 @@ pub(super) fn tessellate(
                     &counted,
                     xf,
                     th.space,
+                    needs_jacobians(th.space).then_some(&jacobians[..]),
                 );
                 let mq = Measure { colour, ..m };
                 if passes(&mq) {

@@ -21,7 +21,7 @@ use crate::validate::VertexData;
 use super::each4;
 use super::layer::sample_error;
 use super::view::ToPixels;
-use crate::colour::ColourSpace;
+use crate::colour::{ColourSpace, Matrix3};
 
 /// The screen gradient of the four attributes: `grad[k] = [d/dx, d/dy]`.
 pub(super) type Gradient = [[f64; 2]; 4];
@@ -160,7 +160,9 @@ pub(super) type Cell = [(usize, usize); 4];
 /// `cells` of a face's grid of `n` cells a side, whose nodes come from its grid `g2` of `2 n`
 /// (the same points at even positions), against the samples of its grid `g4` of `4 n` at the
 /// nine quarter points of each triangle (at their true screen positions). `counted[c]`: whether
-/// cell `c`'s colour counts (see [`super::layer::measure_quad`]). Infinite where a counted
+/// cell `c`'s colour counts (see [`super::layer::measure_quad`]). `jacobians`: in spaces whose
+/// distances are not Lab's, the derivative to Lab at the points of `g2` (those at the cells'
+/// centres are read), from [`super::adaptive`]'s linear measure. Infinite where a counted
 /// triangle has no area on the screen.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn measure_cells(
@@ -171,6 +173,7 @@ pub(super) fn measure_cells(
     counted: &[bool],
     xf: &ToPixels,
     space: ColourSpace,
+    jacobians: Option<&[Matrix3]>,
 ) -> f64 {
     let (s2, s4) = (2 * n + 1, 4 * n + 1);
     let at2 = |(i, j): (usize, usize)| &g2[j * s2 + i];
@@ -197,12 +200,8 @@ pub(super) fn measure_cells(
         // Spaces whose distances are not Lab's are measured through the derivative to Lab at
         // the cell's centre (as the linear measure does at each sample): two conversions per
         // test would cost more than the rest of the measure.
-        let centre = at2((cell[0].0 + cell[2].0, cell[0].1 + cell[2].1));
-        let jacobian = matches!(
-            space,
-            ColourSpace::Srgb | ColourSpace::SrgbLinear | ColourSpace::Oklab
-        )
-        .then(|| space.lab_jacobian([centre[2], centre[3], centre[4]]));
+        let centre = (cell[0].0 + cell[2].0, cell[0].1 + cell[2].1);
+        let jacobian = jacobians.map(|j| &j[centre.1 * s2 + centre.0]);
         let p = each4(|k| px(corner(k)));
         let c = each4(|k| attr(corner(k)));
         let triangles = [
@@ -222,7 +221,7 @@ pub(super) fn measure_cells(
             let mut check = |(i, j): (usize, usize)| {
                 let d = at4(i, j);
                 let shown = q.eval(px(d));
-                worst = worst.max(sample_error(space, attr(d), shown, jacobian.as_ref()));
+                worst = worst.max(sample_error(space, attr(d), shown, jacobian));
             };
             for e in 0..3 {
                 let (a, b, r) = (v[e], v[(e + 1) % 3], v[(e + 2) % 3]);
