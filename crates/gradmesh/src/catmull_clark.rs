@@ -180,6 +180,29 @@ impl Stencils {
         out
     }
 
+    /// [`Stencils::apply`] on the calling thread alone (see
+    /// [`Topology::subdivide_sequential`]).
+    pub(crate) fn apply_sequential(&self, parent: &[VertexData]) -> Vec<VertexData> {
+        let mut out = vec![[0.0; 6]; self.len()];
+        self.apply_range(0, parent, &mut out);
+        out
+    }
+
+    /// Writes stencils `first..first + out.len()` applied to `parent` into `out`.
+    fn apply_range(&self, first: usize, parent: &[VertexData], out: &mut [VertexData]) {
+        for (i, o) in out.iter_mut().enumerate() {
+            let (src, w) = self.stencil(first + i);
+            let mut acc = [0.0; 6];
+            for (&s, &w) in src.iter().zip(w) {
+                let p = &parent[s as usize];
+                for c in 0..6 {
+                    acc[c] += w * p[c];
+                }
+            }
+            *o = acc;
+        }
+    }
+
     /// Applies the stencils to parent data, writing into `out` (one entry per stencil).
     ///
     /// Large tables are applied in parallel; every stencil is summed in the same order whatever
@@ -187,25 +210,12 @@ impl Stencils {
     pub fn apply_into(&self, parent: &[VertexData], out: &mut [VertexData]) {
         use rayon::prelude::*;
         const CHUNK: usize = 1 << 12;
-        let apply = |first: usize, chunk: &mut [VertexData]| {
-            for (i, o) in chunk.iter_mut().enumerate() {
-                let (src, w) = self.stencil(first + i);
-                let mut acc = [0.0; 6];
-                for (&s, &w) in src.iter().zip(w) {
-                    let p = &parent[s as usize];
-                    for c in 0..6 {
-                        acc[c] += w * p[c];
-                    }
-                }
-                *o = acc;
-            }
-        };
         if out.len() <= CHUNK {
-            apply(0, out);
+            self.apply_range(0, parent, out);
         } else {
             out.par_chunks_mut(CHUNK)
                 .enumerate()
-                .for_each(|(k, chunk)| apply(k * CHUNK, chunk));
+                .for_each(|(k, chunk)| self.apply_range(k * CHUNK, parent, chunk));
         }
     }
 
@@ -329,11 +339,19 @@ pub fn refine(parent: &Level) -> (Level, Stencils) {
 
 /// The child level of `parent`, as [`refine`] gives it, without the stencils.
 pub fn refine_level(parent: &Level) -> Level {
+    refine_level_with(parent, parent.topology.subdivide())
+}
+
+/// [`refine_level`] on the calling thread alone (see [`Topology::subdivide_sequential`]).
+pub(crate) fn refine_level_sequential(parent: &Level) -> Level {
+    refine_level_with(parent, parent.topology.subdivide_sequential())
+}
+
+/// The child level of `parent`, whose topology is `child_topology`.
+fn refine_level_with(parent: &Level, child_topology: Topology) -> Level {
     let t = &parent.topology;
     let (nf, ne, nv) = (t.face_count(), t.edge_count(), t.vertex_count());
     let vertex_point = |v: u32| (nf + ne + v as usize) as u32;
-
-    let child_topology = t.subdivide();
 
     // Child sharpness: vertex sharpness decays; each half of a parent edge gets the sharpness
     // subdivided at its end vertex; edges inside parent faces are smooth.

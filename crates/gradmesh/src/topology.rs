@@ -380,6 +380,17 @@ impl Topology {
     /// `2 e + k` is the half of edge `e` at its end `k`; `2 E + c` joins the edge point of the
     /// outgoing edge at corner `c` to the face point.
     pub fn subdivide(&self) -> Topology {
+        self.subdivide_on(self.corner_count() >= PARALLEL_MIN_CORNERS)
+    }
+
+    /// [`Topology::subdivide`] on the calling thread alone: for code that holds a lock, which
+    /// must not wait in rayon (the thread could take on a task that wants the same lock).
+    pub(crate) fn subdivide_sequential(&self) -> Topology {
+        self.subdivide_on(false)
+    }
+
+    /// [`Topology::subdivide`], its parts built concurrently if `parallel`.
+    fn subdivide_on(&self, parallel: bool) -> Topology {
         let (nf, ne, nv, nc) = (
             self.face_count(),
             self.edge_count(),
@@ -536,10 +547,10 @@ impl Topology {
         // Concurrently where it pays: a small mesh (a face's neighbourhood, refined locally)
         // is built in less time than handing its parts to other threads takes.
         let ((face_offsets, face_verts, face_edges), ((edge_verts, edge_faces), rings)) =
-            if nc < PARALLEL_MIN_CORNERS {
-                (faces(), (edges(), rings()))
-            } else {
+            if parallel {
                 rayon::join(faces, || rayon::join(edges, rings))
+            } else {
+                (faces(), (edges(), rings()))
             };
         let (ring_offsets, ring_faces, ring_corners, edge_ring_offsets, ring_edges) = rings;
 

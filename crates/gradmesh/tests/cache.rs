@@ -69,6 +69,16 @@ fn cached_renders_equal_fresh_ones_and_prepare_only_what_changed() {
         [true, true, true, false, true, true]
     );
 
+    // A point moved: its layer is prepared again, reusing the local refinements kept for its
+    // topology (the pixels are checked against a render from scratch).
+    let p = &mut doc.layers[2].points[7];
+    p.position.x += 3.0;
+    p.position.y -= 2.0;
+    assert_eq!(
+        render_both(&doc, &opts, &mut cache),
+        [true, true, false, true, true, true]
+    );
+
     // Drawing-only options keep every layer.
     opts.background = Some([1.0, 1.0, 1.0, 1.0]);
     opts.dither = false;

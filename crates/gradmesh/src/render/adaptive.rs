@@ -375,7 +375,7 @@ struct Plan {
     linear_colour: Option<f64>,
 }
 
-/// Tessellates the layer adaptively, or `None` where the fast path does not apply (a face
+/// Tessellates the layer adaptively (sharing local refinements through `shapes`), or `None` where the fast path does not apply (a face
 /// that is not a quad at the base level, a neighbourhood that is not a valid mesh on its own,
 /// semi-sharpness on the outline down to [`DEEPEST_BASE_LEVEL`]): the caller then refines
 /// uniformly.
@@ -386,6 +386,7 @@ pub(super) fn tessellate(
     th: &Thresholds,
     max_level: usize,
     size: (i64, i64),
+    shapes: &ShapeCache,
 ) -> Option<Tessellation> {
     // Faces refine on their own from the base level with bare stencils: it must lie below the
     // rings of the deepest multi-resolution edit.
@@ -426,7 +427,6 @@ pub(super) fn tessellate(
         |f: usize| -> [bool; 4] { each4(|k| t.is_boundary_edge(t.face_edges(f)[k] as usize)) };
 
     let regular = regular_corners(level);
-    let shapes = ShapeCache::default();
 
     // 1. The density of each face.
     let orders = CellOrders::new(n_max.max(1) * 2);
@@ -585,7 +585,8 @@ pub(super) fn tessellate(
     let groups: Vec<&[(usize, usize)]> = irregular.chunk_by(|a, b| a.0 == b.0).collect();
     // Each face planned with its local refinement and its root there, kept for the counts
     // step 2 asks for: cutting out and refining a face's neighbourhood alone again cost
-    // Glasses a tenth of a millisecond a face.
+    // Glasses a tenth of a millisecond a face. Faces of one group take turns at its lock;
+    // what runs under it stays on its thread (see `patches::LocalShape`).
     type Planned = Vec<(usize, Plan, Arc<Mutex<LocalPatch>>, usize)>;
     let kept = |src: Source| -> Option<Arc<Mutex<LocalPatch>>> {
         match src {
@@ -597,7 +598,7 @@ pub(super) fn tessellate(
         group
             .iter()
             .map(|&(_, f)| {
-                let mut src = Source::new(level, &regular, d, f, &shapes)?;
+                let mut src = Source::new(level, &regular, d, f, shapes)?;
                 let plan = plan_face(f, &mut src)?;
                 Some((f, plan, kept(src)?, 0))
             })
@@ -606,7 +607,7 @@ pub(super) fn tessellate(
     let together = |group: &[(usize, usize)]| -> Option<Planned> {
         let faces: Vec<usize> = group.iter().map(|&(_, f)| f).collect();
         let mut src = Source::Local {
-            patch: LocalPatch::new(level, d, &faces, &shapes)?,
+            patch: LocalPatch::new(level, d, &faces, shapes)?,
             root: 0,
         };
         let mut planned = Vec::with_capacity(faces.len());
@@ -647,7 +648,7 @@ pub(super) fn tessellate(
                 .lock()
                 .unwrap_or_else(|e| e.into_inner())
                 .grid(*root, n),
-            None => Source::new(level, &regular, d, f, &shapes)?.grid(n),
+            None => Source::new(level, &regular, d, f, shapes)?.grid(n),
         }
     };
     let mut plans: Vec<Plan> = plans
@@ -1288,7 +1289,16 @@ mod tests {
         opts.colour_tolerance = tolerance;
         let xf = ToPixels::new(&opts.view, 400, 400);
         let th = Thresholds::new(&opts, ColourSpace::Lab);
-        let tess = tessellate(&mut refinement, &mut data, &xf, &th, 12, (400, 400)).unwrap();
+        let tess = tessellate(
+            &mut refinement,
+            &mut data,
+            &xf,
+            &th,
+            12,
+            (400, 400),
+            &ShapeCache::default(),
+        )
+        .unwrap();
         if quadratic {
             assert!(tess.triangles.iter().any(|t| t.is_quadratic()));
         }
@@ -1366,7 +1376,16 @@ mod tests {
         let th = Thresholds::new(&opts, ColourSpace::Lab);
         let (mut refinement, _) = Refinement::new(&doc.layers[0], 2).unwrap();
         let mut data = refinement.evaluate();
-        let tess = tessellate(&mut refinement, &mut data, &xf, &th, 12, (w, h)).unwrap();
+        let tess = tessellate(
+            &mut refinement,
+            &mut data,
+            &xf,
+            &th,
+            12,
+            (w, h),
+            &ShapeCache::default(),
+        )
+        .unwrap();
         (doc, opts, tess)
     }
 

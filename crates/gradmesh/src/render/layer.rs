@@ -17,6 +17,7 @@ use super::adaptive;
 use super::coverage::Line;
 use super::nearest::{NearestSegments, Segment};
 use super::outline::{boundary_loops, outline};
+use super::patches::ShapeCache;
 use super::triangles::{snap, Bounds, Triangle, TriangleList, SUBPIXEL, UNBOUNDED};
 use super::view::ToPixels;
 use super::{each3, each4, LayerInfo, LayerTimings, RenderOptions};
@@ -635,12 +636,14 @@ fn uniform_triangles(
 /// nothing of it reaches the image) and the warnings of its validation.
 pub(crate) type Prepared = (LayerInfo, Option<PreparedLayer>, Vec<Warning>);
 
-/// Prepares layer `index` of a document for drawing.
+/// Prepares layer `index` of a document for drawing, sharing local refinements through
+/// `shapes`.
 pub(crate) fn prepare(
     mesh: &GradientMesh,
     index: usize,
     opts: &RenderOptions,
     xf: &ToPixels,
+    shapes: &ShapeCache,
 ) -> Result<Prepared, Error> {
     if mesh.faces.is_empty() {
         return Ok((LayerInfo::default(), None, Vec::new()));
@@ -673,7 +676,15 @@ pub(crate) fn prepare(
     let fast = if opts.reference || opts.level.is_some() || opts.max_level < adaptive::BASE_LEVEL {
         None
     } else {
-        adaptive::tessellate(&mut refinement, &mut data, xf, &th, opts.max_level, (w, h))
+        adaptive::tessellate(
+            &mut refinement,
+            &mut data,
+            xf,
+            &th,
+            opts.max_level,
+            (w, h),
+            shapes,
+        )
     };
     let (k, triangles, segments, bounds, mut info) = match fast {
         Some(tess) => {

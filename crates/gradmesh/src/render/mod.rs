@@ -105,6 +105,7 @@ mod triangles;
 mod view;
 
 use std::ops::Range;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
@@ -121,6 +122,7 @@ pub use view::{document_bounds, View};
 
 use gamut::RUN;
 use layer::{PreparedLayer, BAND};
+use patches::ShapeCache;
 use view::ToPixels;
 
 /// The largest image side accepted.
@@ -397,13 +399,23 @@ pub fn render_document_into<P: OutputPixel>(
 /// An editor that drags a point of one layer then pays for that layer's preparation and the
 /// drawing, not for the other layers. The cache holds a copy of each mesh it compares against,
 /// and the prepared triangles and outlines (a few megabytes for a dense layer at 1024 pixels).
+/// It also keeps the structure of the local refinements around extraordinary vertices and
+/// creases, which depends on the topology alone: a layer whose points or colours moved
+/// reuses them.
 #[derive(Default)]
 pub struct RenderCache {
+    /// Local refinements by shape of neighbourhood, for all layers (cleared when they pile
+    /// up past [`MAX_CACHED_SHAPES`]).
+    shapes: Arc<ShapeCache>,
     /// The options the entries were prepared with, with the drawing-only fields reset.
     key: Option<RenderOptions>,
     /// Per layer, by position: the mesh prepared and what preparing it gave.
     layers: Vec<Option<(GradientMesh, layer::Prepared)>>,
 }
+
+/// The most shapes of local refinement a [`RenderCache`] keeps: a few hundred kilobytes each
+/// at most, and a layer has a few dozen.
+const MAX_CACHED_SHAPES: usize = 1024;
 
 impl RenderCache {
     /// An empty cache.
@@ -464,7 +476,14 @@ fn render<P: OutputPixel>(
             cache.layers.clear();
         }
         cache.layers.resize_with(doc.layers.len(), || None);
+        if cache.shapes.len() > MAX_CACHED_SHAPES {
+            cache.shapes = Arc::default();
+        }
     }
+    let shapes: Arc<ShapeCache> = cache
+        .as_deref()
+        .map(|c| Arc::clone(&c.shapes))
+        .unwrap_or_default();
     // The layers to prepare (`None`: taken from the cache).
     let cached = cache.as_deref().map(|c| c.layers.as_slice());
     let fresh: Vec<Option<layer::Prepared>> = doc
@@ -478,7 +497,7 @@ fn render<P: OutputPixel>(
             if hit {
                 Ok(None)
             } else {
-                layer::prepare(mesh, i, opts, &xf).map(Some)
+                layer::prepare(mesh, i, opts, &xf, &shapes).map(Some)
             }
         })
         .collect::<Result<_, _>>()?;

@@ -351,6 +351,11 @@ struct ShapeDepth {
 }
 
 /// The local refinement of one shape of neighbourhood, deepened as far as some face asks.
+///
+/// Its depths are built under a lock, and a [`LocalPatch`] is refined further under its
+/// owner's lock ([`super::adaptive`]): nothing under them waits in rayon (the `_sequential`
+/// subdivision and stencils), since a thread waiting there may take on a task that wants the
+/// same lock, and deadlock.
 struct LocalShape {
     /// The depths built so far, and whether the next one failed (its faces did not form a
     /// valid mesh on their own).
@@ -398,6 +403,13 @@ struct ShapeKey {
 /// cuts out 96 neighbourhoods of about 35 shapes at 1024 px.
 #[derive(Default)]
 pub(crate) struct ShapeCache(Mutex<HashMap<ShapeKey, Option<Arc<LocalShape>>>>);
+
+impl ShapeCache {
+    /// How many shapes it holds.
+    pub fn len(&self) -> usize {
+        self.0.lock().unwrap_or_else(|e| e.into_inner()).len()
+    }
+}
 
 /// Faces refined on their own, feature-adaptively: at each depth the descendants that have
 /// become regular patches are set aside, and only the faces around the others (which
@@ -527,7 +539,7 @@ fn neighbourhood(t: &Topology, tiles: &[Tile]) -> Vec<u32> {
 /// set aside, and the faces around the others kept. `None` if those do not form a valid mesh.
 fn deepen(last: &ShapeDepth) -> Option<ShapeDepth> {
     let last_level = last.local.as_ref().expect("a depth with tiles has a mesh");
-    let child = catmull_clark::refine_level(last_level);
+    let child = catmull_clark::refine_level_sequential(last_level);
     let mut tiles = Vec::with_capacity(4 * last.tiles.len());
     for tile in &last.tiles {
         tiles.extend(tile.children(last_level.topology.face_offset(tile.face as usize)));
@@ -680,7 +692,7 @@ impl LocalPatch {
                 .refine
                 .as_ref()
                 .expect("below depth 0")
-                .apply(self.rows.last().expect("depth 0"));
+                .apply_sequential(self.rows.last().expect("depth 0"));
             self.depths.push(next);
             self.rows.push(rows);
             self.corner_limits.push(None);
@@ -744,8 +756,8 @@ impl LocalPatch {
                 Some((slot, stencils))
             })
             .as_ref()?;
-        let limits =
-            self.corner_limits[depth].get_or_insert_with(|| stencils.apply(&self.rows[depth]));
+        let limits = self.corner_limits[depth]
+            .get_or_insert_with(|| stencils.apply_sequential(&self.rows[depth]));
         for tile in at.tiles.iter().filter(|tile| tile.root == root) {
             let o = tile.origin;
             let corners = [
