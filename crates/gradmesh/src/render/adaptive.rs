@@ -140,7 +140,7 @@ enum Source {
 
 impl Source {
     /// `regular`: whether each vertex of `level` is a regular corner ([`regular_corners`]);
-    /// `shapes`: the layer's local refinements.
+    /// `shapes`: the local refinements shared by shape of neighbourhood.
     fn new(
         level: &Level,
         regular: &[bool],
@@ -375,10 +375,10 @@ struct Plan {
     linear_colour: Option<f64>,
 }
 
-/// Tessellates the layer adaptively (sharing local refinements through `shapes`), or `None` where the fast path does not apply (a face
-/// that is not a quad at the base level, a neighbourhood that is not a valid mesh on its own,
-/// semi-sharpness on the outline down to [`DEEPEST_BASE_LEVEL`]): the caller then refines
-/// uniformly.
+/// Tessellates the layer adaptively, sharing local refinements by shape through `shapes`, or
+/// `None` where the fast path does not apply (a face that is not a quad at the base level, a
+/// neighbourhood that is not a valid mesh on its own, semi-sharpness on the outline down to
+/// [`DEEPEST_BASE_LEVEL`]): the caller then refines uniformly.
 pub(super) fn tessellate(
     refinement: &mut Refinement,
     data: &mut RefinedMesh,
@@ -1199,6 +1199,17 @@ mod tests {
     use crate::GradientMesh;
     use kurbo::Point;
 
+    /// [`tessellate`] down to level 12, with local refinements of its own.
+    fn tessellate_alone(
+        refinement: &mut Refinement,
+        data: &mut RefinedMesh,
+        xf: &ToPixels,
+        th: &Thresholds,
+        size: (i64, i64),
+    ) -> Option<Tessellation> {
+        tessellate(refinement, data, xf, th, 12, size, &ShapeCache::default())
+    }
+
     /// What a layer can cover: the box around its points, clipped to the image.
     #[test]
     fn covered_pixels_are_the_points_box_clipped_to_the_image() {
@@ -1289,16 +1300,7 @@ mod tests {
         opts.colour_tolerance = tolerance;
         let xf = ToPixels::new(&opts.view, 400, 400);
         let th = Thresholds::new(&opts, ColourSpace::Lab);
-        let tess = tessellate(
-            &mut refinement,
-            &mut data,
-            &xf,
-            &th,
-            12,
-            (400, 400),
-            &ShapeCache::default(),
-        )
-        .unwrap();
+        let tess = tessellate_alone(&mut refinement, &mut data, &xf, &th, (400, 400)).unwrap();
         if quadratic {
             assert!(tess.triangles.iter().any(|t| t.is_quadratic()));
         }
@@ -1376,16 +1378,7 @@ mod tests {
         let th = Thresholds::new(&opts, ColourSpace::Lab);
         let (mut refinement, _) = Refinement::new(&doc.layers[0], 2).unwrap();
         let mut data = refinement.evaluate();
-        let tess = tessellate(
-            &mut refinement,
-            &mut data,
-            &xf,
-            &th,
-            12,
-            (w, h),
-            &ShapeCache::default(),
-        )
-        .unwrap();
+        let tess = tessellate_alone(&mut refinement, &mut data, &xf, &th, (w, h)).unwrap();
         (doc, opts, tess)
     }
 
