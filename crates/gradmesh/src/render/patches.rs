@@ -1051,7 +1051,7 @@ mod tests {
         let first = a.grid(1, 16).unwrap();
         let mut b = LocalPatch::new(&level, &other, &around, &shared).unwrap();
         let second = [b.grid(3, 4).unwrap(), b.grid(2, 32).unwrap()];
-        assert_eq!(shared.0.lock().unwrap().len(), 1, "one shape");
+        assert_eq!(shared.len(), 1, "one shape");
         let alone = |data: &[VertexData], root: usize, n: usize| {
             let mut patch = LocalPatch::new(&level, data, &around, &ShapeCache::default()).unwrap();
             patch.grid(root, n).unwrap()
