@@ -1,6 +1,6 @@
 //! `RenderCache`: renders that reuse prepared layers are identical to renders from scratch, and
 //! only the layers that changed (or all, when an option that shapes preparation changed) are
-//! prepared again.
+//! prepared again, each planning again only the faces an edit touched.
 
 use gradmesh::formats::read_path;
 use gradmesh::render::{
@@ -35,6 +35,15 @@ fn options(doc: &Document, width: u32) -> RenderOptions {
 /// Renders with the cache and from scratch; asserts the pixels agree and returns which layers
 /// were reused.
 fn render_both(doc: &Document, opts: &RenderOptions, cache: &mut RenderCache) -> Vec<bool> {
+    render_both_counting(doc, opts, cache).0
+}
+
+/// [`render_both`], and how many faces of each layer kept their plans.
+fn render_both_counting(
+    doc: &Document,
+    opts: &RenderOptions,
+    cache: &mut RenderCache,
+) -> (Vec<bool>, Vec<usize>) {
     let n = 4 * (opts.width * opts.height) as usize;
     let (mut cached, mut fresh) = (vec![0u8; n], vec![0u8; n]);
     let info = render_document_into_cached(doc, opts, cache, &mut cached).unwrap();
@@ -49,7 +58,11 @@ fn render_both(doc: &Document, opts: &RenderOptions, cache: &mut RenderCache) ->
         );
     }
     assert_eq!(info.warnings, plain.warnings);
-    info.layers.iter().map(|l| l.reused).collect()
+    assert!(plain.layers.iter().all(|l| l.reused_faces == 0));
+    (
+        info.layers.iter().map(|l| l.reused).collect(),
+        info.layers.iter().map(|l| l.reused_faces).collect(),
+    )
 }
 
 #[test]
@@ -58,22 +71,33 @@ fn cached_renders_equal_fresh_ones_and_prepare_only_what_changed() {
     let mut opts = options(&doc, 300);
     let mut cache = RenderCache::new();
 
-    assert_eq!(render_both(&doc, &opts, &mut cache), [false; 6]);
-    assert_eq!(render_both(&doc, &opts, &mut cache), [true; 6]);
-
-    // An edit of one layer: only that one is prepared again.
-    let p = &mut doc.layers[3].points[5];
-    p.colour = [p.colour[0] * 0.8, p.colour[1] + 10.0, p.colour[2]];
+    assert_eq!(render_both_counting(&doc, &opts, &mut cache).1, [0; 6]);
     assert_eq!(
-        render_both(&doc, &opts, &mut cache),
-        [true, true, true, false, true, true]
+        render_both_counting(&doc, &opts, &mut cache),
+        (vec![true; 6], vec![0; 6])
     );
 
+    // An edit of one layer: only that one is prepared again, and in it only the faces near
+    // the point planned again.
+    let p = &mut doc.layers[3].points[5];
+    p.colour = [p.colour[0] * 0.8, p.colour[1] + 10.0, p.colour[2]];
+    let (reused, faces) = render_both_counting(&doc, &opts, &mut cache);
+    assert_eq!(reused, [true, true, true, false, true, true]);
+    assert!(faces[3] > 0, "no face kept its plan: {faces:?}");
+
     // A point moved: its layer is prepared again, reusing the local refinements kept for its
-    // topology (the pixels are checked against a render from scratch).
+    // topology and the plans of the faces far from the point (the pixels are checked against
+    // a render from scratch).
     let p = &mut doc.layers[2].points[7];
     p.position.x += 3.0;
     p.position.y -= 2.0;
+    let (reused, faces) = render_both_counting(&doc, &opts, &mut cache);
+    assert_eq!(reused, [true, true, false, true, true, true]);
+    assert!(faces[2] > 0, "no face kept its plan: {faces:?}");
+    // Moved back: the faces around the point plan again, to the first render's pixels.
+    let p = &mut doc.layers[2].points[7];
+    p.position.x -= 3.0;
+    p.position.y += 2.0;
     assert_eq!(
         render_both(&doc, &opts, &mut cache),
         [true, true, false, true, true, true]

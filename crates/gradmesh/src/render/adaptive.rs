@@ -122,6 +122,8 @@ pub(super) struct Tessellation {
     /// The bounds of the colours in play (those of the base level, whose convex hull holds
     /// the limit surface), when some face is quadratic.
     pub bounds: Option<Bounds>,
+    /// Regular faces whose plans were taken from the [`PlanMemo`].
+    pub reused_plans: usize,
 }
 
 /// How a face's limit surface is evaluated.
@@ -359,6 +361,7 @@ enum Order {
 }
 
 /// One face's choice: cells a side, its grid, and how it measured.
+#[derive(Clone)]
 struct Plan {
     n: usize,
     grid: Grid,
@@ -375,7 +378,50 @@ struct Plan {
     linear_colour: Option<f64>,
 }
 
-/// Tessellates the layer adaptively, sharing local refinements by shape through `shapes`, or
+/// The plans of a layer's regular faces at its last preparation, kept by a
+/// [`RenderCache`](super::RenderCache) for the next: a regular face's plan depends only on its
+/// control points, which of its sides lie on the outline, and the options (the same for
+/// every entry of a cache), so a face whose control points are the same bits plans the same.
+/// After an edit only the faces whose control points it moved are planned again: a point
+/// moved at level 0 changes the base level's points within a few rings of it.
+#[derive(Default)]
+pub(crate) struct PlanMemo {
+    base_level: usize,
+    faces: Vec<Option<(ControlGrid, [bool; 4], Plan)>>,
+}
+
+impl PlanMemo {
+    /// The plan kept for face `f` if it was planned at `base_level` from the same control
+    /// points and sides.
+    fn get(
+        &self,
+        base_level: usize,
+        f: usize,
+        cp: &ControlGrid,
+        sides: [bool; 4],
+    ) -> Option<&Plan> {
+        if self.base_level != base_level {
+            return None;
+        }
+        let (old, old_sides, plan) = self.faces.get(f)?.as_ref()?;
+        let same = old
+            .iter()
+            .flatten()
+            .zip(cp.iter().flatten())
+            .all(|(a, b)| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()));
+        (same && *old_sides == sides).then_some(plan)
+    }
+}
+
+/// What earlier preparations left that a layer's tessellation may take: the local refinements
+/// by shape (of all layers), and the plans of this layer's regular faces (with a
+/// [`RenderCache`](super::RenderCache); this tessellation's are then left in their place).
+pub(crate) struct Kept<'a> {
+    pub shapes: &'a ShapeCache,
+    pub plans: Option<&'a mut PlanMemo>,
+}
+
+/// Tessellates the layer adaptively, taking what earlier preparations left ([`Kept`]), or
 /// `None` where the fast path does not apply (a face that is not a quad at the base level, a
 /// neighbourhood that is not a valid mesh on its own, semi-sharpness on the outline down to
 /// [`DEEPEST_BASE_LEVEL`]): the caller then refines uniformly.
@@ -386,8 +432,12 @@ pub(super) fn tessellate(
     th: &Thresholds,
     max_level: usize,
     size: (i64, i64),
-    shapes: &ShapeCache,
+    kept: Kept<'_>,
 ) -> Option<Tessellation> {
+    let Kept {
+        shapes,
+        plans: mut memo,
+    } = kept;
     // Faces refine on their own from the base level with bare stencils: it must lie below the
     // rings of the deepest multi-resolution edit.
     while data.levels.len() <= 1 {
@@ -565,13 +615,42 @@ pub(super) fn tessellate(
             }
         }
     };
-    // Regular faces first, each on its own.
-    let mut plans: Vec<Option<Plan>> = each_face(nf, |f| {
-        match regular_patch_with(level, d, f, |v| regular[v]) {
-            Some(cp) => plan_face(f, &mut Source::Regular(cp)).map(Some),
-            None => Some(None),
+    // Regular faces first, each on its own, or as the memo of the last preparation has them.
+    // Faces planned afresh are remembered for the next (the others are there already).
+    let old_memo = memo
+        .as_deref()
+        .filter(|m| m.base_level == k0 && m.faces.len() == nf);
+    type Remembered = (ControlGrid, [bool; 4], Plan);
+    let planned: Vec<(Option<Plan>, Option<Remembered>, bool)> = each_face(nf, |f| {
+        let Some(cp) = regular_patch_with(level, d, f, |v| regular[v]) else {
+            return Some((None, None, false));
+        };
+        let sides = boundary_sides(f);
+        if let Some(plan) = old_memo.and_then(|m| m.get(k0, f, &cp, sides)) {
+            return Some((Some(plan.clone()), None, true));
         }
+        let plan = plan_face(f, &mut Source::Regular(cp))?;
+        let remembered = memo.is_some().then(|| (cp, sides, plan.clone()));
+        Some((Some(plan), remembered, false))
     })?;
+    let reused_plans = planned.iter().filter(|p| p.2).count();
+    let fresh_memo = old_memo.is_none();
+    if let Some(memo) = memo.as_deref_mut() {
+        if fresh_memo {
+            memo.base_level = k0;
+            memo.faces.clear();
+            memo.faces.resize_with(nf, || None);
+        }
+    }
+    let mut plans: Vec<Option<Plan>> = Vec::with_capacity(nf);
+    for (f, (plan, remembered, kept)) in planned.into_iter().enumerate() {
+        if let Some(memo) = memo.as_deref_mut() {
+            if !kept {
+                memo.faces[f] = remembered;
+            }
+        }
+        plans.push(plan);
+    }
     // The others refine locally, grouped by their first corner that is not regular (for
     // most, the extraordinary vertex they surround): a group shares one local refinement.
     let mut irregular: Vec<(usize, usize)> = (0..nf)
@@ -1116,6 +1195,7 @@ pub(super) fn tessellate(
         triangles,
         segments,
         bounds,
+        reused_plans,
     })
 }
 
@@ -1207,7 +1287,18 @@ mod tests {
         th: &Thresholds,
         size: (i64, i64),
     ) -> Option<Tessellation> {
-        tessellate(refinement, data, xf, th, 12, size, &ShapeCache::default())
+        tessellate(
+            refinement,
+            data,
+            xf,
+            th,
+            12,
+            size,
+            Kept {
+                shapes: &ShapeCache::default(),
+                plans: None,
+            },
+        )
     }
 
     /// What a layer can cover: the box around its points, clipped to the image.
@@ -1380,6 +1471,70 @@ mod tests {
         let mut data = refinement.evaluate();
         let tess = tessellate_alone(&mut refinement, &mut data, &xf, &th, (w, h)).unwrap();
         (doc, opts, tess)
+    }
+
+    /// A memo of plans gives the same tessellation as planning afresh; after a point moved,
+    /// only the faces around it plan again.
+    #[test]
+    fn remembered_plans_are_taken_for_faces_an_edit_left_alone() {
+        let dir = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../../shared/realdata/gradientmeshimproved-off/"
+        );
+        let mut doc =
+            crate::formats::read_path(&std::path::PathBuf::from(dir).join("Glasses.off")).unwrap();
+        let opts = RenderOptions::fit(&doc, 500);
+        let (w, h) = (opts.width as i64, opts.height as i64);
+        let xf = ToPixels::new(&opts.view, opts.width, opts.height);
+        let th = Thresholds::new(&opts, ColourSpace::Lab);
+        let shapes = ShapeCache::default();
+        let run = |mesh: &crate::GradientMesh, memo: Option<&mut PlanMemo>| {
+            let (mut refinement, _) = Refinement::new(mesh, 1).unwrap();
+            let mut data = refinement.evaluate();
+            tessellate(
+                &mut refinement,
+                &mut data,
+                &xf,
+                &th,
+                12,
+                (w, h),
+                Kept {
+                    shapes: &shapes,
+                    plans: memo,
+                },
+            )
+            .unwrap()
+        };
+        let same = |a: &Tessellation, b: &Tessellation| {
+            assert_eq!(a.triangles.len(), b.triangles.len());
+            for (x, y) in a.triangles.iter().zip(b.triangles.iter()) {
+                assert_eq!(format!("{x:?}"), format!("{y:?}"));
+            }
+        };
+        let mut memo = PlanMemo::default();
+        let first = run(&doc.layers[0], Some(&mut memo));
+        assert_eq!(first.reused_plans, 0);
+        same(&first, &run(&doc.layers[0], None));
+        // Unchanged: every regular face keeps its plan.
+        let again = run(&doc.layers[0], Some(&mut memo));
+        let regular = memo.faces.iter().flatten().count();
+        assert!(regular > 1000, "{regular} regular faces");
+        assert_eq!(again.reused_plans, regular);
+        same(&again, &first);
+        // A point moved: the faces within its reach plan again, and the result is a fresh one's.
+        doc.layers[0].points[40].position.x += 2.0;
+        let moved = run(&doc.layers[0], Some(&mut memo));
+        assert!(
+            moved.reused_plans > regular / 2,
+            "{} of {regular}",
+            moved.reused_plans
+        );
+        assert!(
+            moved.reused_plans < regular,
+            "{} of {regular}",
+            moved.reused_plans
+        );
+        same(&moved, &run(&doc.layers[0], None));
     }
 
     /// Pixel coverage counts of a tessellation.

@@ -637,13 +637,15 @@ fn uniform_triangles(
 pub(crate) type Prepared = (LayerInfo, Option<PreparedLayer>, Vec<Warning>);
 
 /// Prepares layer `index` of a document for drawing, sharing local refinements through
-/// `shapes`.
+/// `shapes`, and taking the plans of unchanged regular faces from `memo` (which then holds
+/// this preparation's: see [`adaptive::PlanMemo`]).
 pub(crate) fn prepare(
     mesh: &GradientMesh,
     index: usize,
     opts: &RenderOptions,
     xf: &ToPixels,
     shapes: &ShapeCache,
+    memo: Option<&mut adaptive::PlanMemo>,
 ) -> Result<Prepared, Error> {
     if mesh.faces.is_empty() {
         return Ok((LayerInfo::default(), None, Vec::new()));
@@ -683,7 +685,10 @@ pub(crate) fn prepare(
             &th,
             opts.max_level,
             (w, h),
-            shapes,
+            adaptive::Kept {
+                shapes,
+                plans: memo,
+            },
         )
     };
     let (k, triangles, segments, bounds, mut info) = match fast {
@@ -700,6 +705,7 @@ pub(crate) fn prepare(
                 estimated: tess.estimated,
                 timings,
                 reused: false,
+                reused_faces: tess.reused_plans,
             };
             (
                 tess.base_level,
@@ -725,6 +731,7 @@ pub(crate) fn prepare(
                 estimated: choice.estimated,
                 timings,
                 reused: false,
+                reused_faces: 0,
             };
             (choice.level, triangles, segments, None, info)
         }

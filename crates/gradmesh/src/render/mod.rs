@@ -324,6 +324,9 @@ pub struct LayerInfo {
     pub timings: LayerTimings,
     /// Whether the layer was taken from a [`RenderCache`] rather than prepared.
     pub reused: bool,
+    /// Faces whose plans (grid density and samples) were taken from a [`RenderCache`] when
+    /// the layer was prepared again: after an edit, the faces it left alone.
+    pub reused_faces: usize,
 }
 
 /// Wall-clock time of the stages that prepare one layer (layers are prepared in parallel, so
@@ -400,8 +403,10 @@ pub fn render_document_into<P: OutputPixel>(
 /// drawing, not for the other layers. The cache holds a copy of each mesh it compares against,
 /// and the prepared triangles and outlines (a few megabytes for a dense layer at 1024 pixels).
 /// It also keeps the structure of the local refinements around extraordinary vertices and
-/// creases, which depends on the topology alone: a layer whose points or colours moved
-/// reuses them.
+/// creases, which depends on the topology alone, and the plan of each regular face of a
+/// layer (its grid density and samples), which depends on its sixteen control points alone:
+/// a layer whose points or colours moved reuses the first, and plans again only the faces
+/// within reach of what moved ([`LayerInfo::reused_faces`]).
 #[derive(Default)]
 pub struct RenderCache {
     /// Local refinements by shape of neighbourhood, for all layers (cleared when they pile
@@ -411,6 +416,9 @@ pub struct RenderCache {
     key: Option<RenderOptions>,
     /// Per layer, by position: the mesh prepared and what preparing it gave.
     layers: Vec<Option<(GradientMesh, layer::Prepared)>>,
+    /// Per layer, by position: the plans of its regular faces at its last preparation, which
+    /// a layer prepared again after an edit takes for the faces the edit left alone.
+    plans: Vec<adaptive::PlanMemo>,
 }
 
 /// The most shapes of local refinement a [`RenderCache`] keeps: a few hundred kilobytes each
@@ -474,8 +482,10 @@ fn render<P: OutputPixel>(
         if cache.key.as_ref() != Some(&key) {
             cache.key = Some(key);
             cache.layers.clear();
+            cache.plans.clear();
         }
         cache.layers.resize_with(doc.layers.len(), || None);
+        cache.plans.resize_with(doc.layers.len(), Default::default);
         if cache.shapes.len() > MAX_CACHED_SHAPES {
             cache.shapes = Arc::default();
         }
@@ -485,22 +495,33 @@ fn render<P: OutputPixel>(
         .map(|c| Arc::clone(&c.shapes))
         .unwrap_or_default();
     // The layers to prepare (`None`: taken from the cache).
-    let cached = cache.as_deref().map(|c| c.layers.as_slice());
+    let (cached, mut memos) = match cache.as_deref_mut() {
+        Some(c) => (
+            Some(c.layers.as_slice()),
+            c.plans.iter_mut().map(Some).collect(),
+        ),
+        None => (
+            None,
+            (0..doc.layers.len()).map(|_| None).collect::<Vec<_>>(),
+        ),
+    };
     let fresh: Vec<Option<layer::Prepared>> = doc
         .layers
         .par_iter()
+        .zip(memos.par_iter_mut())
         .enumerate()
-        .map(|(i, mesh)| {
+        .map(|(i, (mesh, memo))| {
             let hit = cached
                 .and_then(|c| c[i].as_ref())
                 .is_some_and(|(old, _)| old == mesh);
             if hit {
                 Ok(None)
             } else {
-                layer::prepare(mesh, i, opts, &xf, &shapes).map(Some)
+                layer::prepare(mesh, i, opts, &xf, &shapes, memo.as_deref_mut()).map(Some)
             }
         })
         .collect::<Result<_, _>>()?;
+    drop(memos);
     let reused: Vec<bool> = fresh.iter().map(Option::is_none).collect();
     let kept: Vec<layer::Prepared>;
     let prepared: Vec<&layer::Prepared> = match cache {
@@ -532,6 +553,7 @@ fn render<P: OutputPixel>(
         if reused {
             layer_info.reused = true;
             layer_info.timings = LayerTimings::default();
+            layer_info.reused_faces = 0;
         }
         info.layers.push(layer_info);
         info.warnings.extend(warnings.iter().cloned());
