@@ -77,31 +77,35 @@ fn cached_renders_equal_fresh_ones_and_prepare_only_what_changed() {
         (vec![true; 6], vec![0; 6])
     );
 
-    // An edit of one layer: only that one is prepared again, and in it only the faces near
-    // the point planned again.
+    // An edit of one layer: only that one is prepared again. From then on the cache keeps
+    // its faces' plans, and a second edit plans again only the faces near the point.
     let p = &mut doc.layers[3].points[5];
     p.colour = [p.colour[0] * 0.8, p.colour[1] + 10.0, p.colour[2]];
     let (reused, faces) = render_both_counting(&doc, &opts, &mut cache);
     assert_eq!(reused, [true, true, true, false, true, true]);
+    assert_eq!(faces, [0; 6]);
+    let p = &mut doc.layers[3].points[5];
+    p.colour[2] -= 5.0;
+    let (reused, faces) = render_both_counting(&doc, &opts, &mut cache);
+    assert_eq!(reused, [true, true, true, false, true, true]);
     assert!(faces[3] > 0, "no face kept its plan: {faces:?}");
 
-    // A point moved: its layer is prepared again, reusing the local refinements kept for its
-    // topology and the plans of the faces far from the point (the pixels are checked against
-    // a render from scratch).
+    // A point moved, and moved back: its layer is prepared again, reusing the local
+    // refinements kept for its topology, and the second time the plans of the faces far from
+    // the point (the pixels are checked against a render from scratch).
     let p = &mut doc.layers[2].points[7];
     p.position.x += 3.0;
     p.position.y -= 2.0;
-    let (reused, faces) = render_both_counting(&doc, &opts, &mut cache);
-    assert_eq!(reused, [true, true, false, true, true, true]);
-    assert!(faces[2] > 0, "no face kept its plan: {faces:?}");
-    // Moved back: the faces around the point plan again, to the first render's pixels.
-    let p = &mut doc.layers[2].points[7];
-    p.position.x -= 3.0;
-    p.position.y += 2.0;
     assert_eq!(
         render_both(&doc, &opts, &mut cache),
         [true, true, false, true, true, true]
     );
+    let p = &mut doc.layers[2].points[7];
+    p.position.x -= 3.0;
+    p.position.y += 2.0;
+    let (reused, faces) = render_both_counting(&doc, &opts, &mut cache);
+    assert_eq!(reused, [true, true, false, true, true, true]);
+    assert!(faces[2] > 0, "no face kept its plan: {faces:?}");
 
     // Drawing-only options keep every layer.
     opts.background = Some([1.0, 1.0, 1.0, 1.0]);

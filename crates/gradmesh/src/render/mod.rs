@@ -416,8 +416,9 @@ pub struct RenderCache {
     key: Option<RenderOptions>,
     /// Per layer, by position: the mesh prepared and what preparing it gave.
     layers: Vec<Option<(GradientMesh, layer::Prepared)>>,
-    /// Per layer, by position: the plans of its regular faces at its last preparation, which
-    /// a layer prepared again after an edit takes for the faces the edit left alone.
+    /// Per layer, by position: the plans of its regular faces at its last preparation, once
+    /// it has been prepared again (edited), which a layer prepared again after an edit takes
+    /// for the faces the edit left alone.
     plans: Vec<adaptive::PlanMemo>,
 }
 
@@ -511,14 +512,14 @@ fn render<P: OutputPixel>(
         .zip(memos.par_iter_mut())
         .enumerate()
         .map(|(i, (mesh, memo))| {
-            let hit = cached
-                .and_then(|c| c[i].as_ref())
-                .is_some_and(|(old, _)| old == mesh);
-            if hit {
-                Ok(None)
-            } else {
-                layer::prepare(mesh, i, opts, &xf, &shapes, memo.as_deref_mut()).map(Some)
+            let entry = cached.and_then(|c| c[i].as_ref());
+            if entry.is_some_and(|(old, _)| old == mesh) {
+                return Ok(None);
             }
+            // Plans are kept for layers prepared again (edited): keeping every layer's would
+            // cost a copy of its plans at its first preparation, and memory, for nothing.
+            let memo = memo.as_deref_mut().filter(|_| entry.is_some());
+            layer::prepare(mesh, i, opts, &xf, &shapes, memo).map(Some)
         })
         .collect::<Result<_, _>>()?;
     drop(memos);
