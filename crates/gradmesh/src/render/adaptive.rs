@@ -387,6 +387,9 @@ struct Plan {
 #[derive(Default)]
 pub(crate) struct PlanMemo {
     base_level: usize,
+    /// The working space the colours are in (a layer whose space changed, and whose points
+    /// are black, would have the same bits in another space).
+    space: Option<ColourSpace>,
     faces: Vec<Option<(ControlGrid, [bool; 4], Plan)>>,
 }
 
@@ -619,7 +622,7 @@ pub(super) fn tessellate(
     // Faces planned afresh are remembered for the next (the others are there already).
     let old_memo = memo
         .as_deref()
-        .filter(|m| m.base_level == k0 && m.faces.len() == nf);
+        .filter(|m| m.base_level == k0 && m.space == Some(th.space) && m.faces.len() == nf);
     type Remembered = (ControlGrid, [bool; 4], Plan);
     let planned: Vec<(Option<Plan>, Option<Remembered>, bool)> = each_face(nf, |f| {
         let Some(cp) = regular_patch_with(level, d, f, |v| regular[v]) else {
@@ -638,6 +641,7 @@ pub(super) fn tessellate(
     if let Some(memo) = memo.as_deref_mut() {
         if fresh_memo {
             memo.base_level = k0;
+            memo.space = Some(th.space);
             memo.faces.clear();
             memo.faces.resize_with(nf, || None);
         }
@@ -1535,6 +1539,17 @@ mod tests {
             moved.reused_plans
         );
         same(&moved, &run(&doc.layers[0], None));
+        // The same bits in another working space are other colours: nothing is kept (capped
+        // at level 4: read as Oklab, these colours would take deep grids).
+        let th = Thresholds::new(&opts, ColourSpace::Oklab);
+        let (mut refinement, _) = Refinement::new(&doc.layers[0], 1).unwrap();
+        let mut data = refinement.evaluate();
+        let kept = Kept {
+            shapes: &shapes,
+            plans: Some(&mut memo),
+        };
+        let other = tessellate(&mut refinement, &mut data, &xf, &th, 4, (w, h), kept).unwrap();
+        assert_eq!(other.reused_plans, 0);
     }
 
     /// Pixel coverage counts of a tessellation.
