@@ -1075,10 +1075,14 @@ fn shade_row<const FRESH: bool>(
         colour,
     } = band;
     let mut made_opaque = 0;
-    let mut put = |k: usize, rgb: [f32; 3], alpha: f32, opaque: &mut [bool]| {
+    // Composites pixel `k`'s colour; 1 if it became opaque. The buffers are arguments, so
+    // that the loops below may also write them directly.
+    let put = |colour: &mut [[f32; 4]], opaque: &mut [bool], k: usize, rgb: [f32; 3], alpha| {
         if under(&mut colour[k], rgb, alpha, FRESH) {
             opaque[k] = true;
-            made_opaque += 1;
+            1
+        } else {
+            0
         }
     };
     // The pixel's attributes and opacity, unless the layer leaves it alone.
@@ -1129,7 +1133,8 @@ fn shade_row<const FRESH: bool>(
             }
             shading.converter.convert(&run.colour, n, &mut run.rgb);
             for m in 0..n {
-                put(run.pixel[m] as usize, run.rgb[m], run.alpha[m], opaque);
+                let (k, rgb, alpha) = (run.pixel[m] as usize, run.rgb[m], run.alpha[m]);
+                made_opaque += put(colour, opaque, k, rgb, alpha);
             }
         }
     } else {
@@ -1138,21 +1143,15 @@ fn shade_row<const FRESH: bool>(
         let (gamut, blend) = (shading.gamut, shading.blend);
         if shading.rarely_outside {
             // Colours in range need nothing (SVG's, Cairo's), and the search below cost the
-            // `vs_cairo` scene 8 % more time. One pixel; whether it became opaque:
-            let one = |i: usize, opaque: &mut [bool], colour: &mut [[f32; 4]]| -> bool {
+            // `vs_cairo` scene 8 % more time. One pixel:
+            let one = |i: usize, opaque: &mut [bool], colour: &mut [[f32; 4]]| -> usize {
                 let Some((attr, alpha)) = shown(i, opaque) else {
-                    return false;
+                    return 0;
                 };
                 let c = [attr[0], attr[1], attr[2]];
                 let rgb = gamut::to_blend_space_f32(shading.space, c, gamut, blend);
-                let k = row + i;
-                if under(&mut colour[k], rgb, alpha, FRESH) {
-                    opaque[k] = true;
-                    return true;
-                }
-                false
+                put(colour, opaque, row + i, rgb, alpha)
             };
-            let mut made = 0;
             let mut i = cols.start;
             if FRESH {
                 // Most blocks of a fresh layer's interior are whole ([`whole_block`]) and in
@@ -1168,19 +1167,19 @@ fn shade_row<const FRESH: bool>(
                             *dst = [a[0], a[1], a[2], 1.0];
                         }
                         opaque[k..k + BLOCK].fill(true);
-                        made += BLOCK;
+                        made_opaque += BLOCK;
                     } else {
                         for j in i..i + BLOCK {
-                            made += usize::from(one(j, opaque, colour));
+                            made_opaque += one(j, opaque, colour);
                         }
                     }
                     i += BLOCK;
                 }
             }
             for j in i..cols.end {
-                made += usize::from(one(j, opaque, colour));
+                made_opaque += one(j, opaque, colour);
             }
-            return made;
+            return made_opaque;
         }
         // Colours that need the chroma search wait, and take it many at a time. In stretches
         // of as many pixels as the search has lanes, so that the pixel loop need not test for
@@ -1193,15 +1192,19 @@ fn shade_row<const FRESH: bool>(
                 if let Some((attr, alpha)) = shown(i, opaque) {
                     let c = [attr[0], attr[1], attr[2]];
                     match gamut::to_blend_space_f32_or_outside(shading.space, c, gamut, blend) {
-                        Ok(rgb) => put(row + i, rgb, alpha, opaque),
+                        Ok(rgb) => made_opaque += put(colour, opaque, row + i, rgb, alpha),
                         Err(linear) => waiting.add(row + i, linear, alpha),
                     }
                 }
             }
-            waiting.map_group(gamut, blend, |k, rgb, alpha| put(k, rgb, alpha, opaque));
+            waiting.map_group(gamut, blend, |k, rgb, alpha| {
+                made_opaque += put(colour, opaque, k, rgb, alpha)
+            });
             start = end;
         }
-        waiting.map_rest(gamut, blend, |k, rgb, alpha| put(k, rgb, alpha, opaque));
+        waiting.map_rest(gamut, blend, |k, rgb, alpha| {
+            made_opaque += put(colour, opaque, k, rgb, alpha)
+        });
     }
     made_opaque
 }
