@@ -380,8 +380,9 @@ struct Plan {
 
 /// The plans of a layer's regular faces at its last preparation, kept by a
 /// [`RenderCache`](super::RenderCache) for the next: a regular face's plan depends only on its
-/// control points, which of its sides lie on the outline, and the options (the same for
-/// every entry of a cache), so a face whose control points are the same bits plans the same.
+/// control points, which of its sides lie on the outline, the working space and the options
+/// (the same for every entry of a cache), so a face whose control points are the same bits
+/// plans the same.
 /// After an edit only the faces whose control points it moved are planned again: a point
 /// moved at level 0 changes the base level's points within a few rings of it.
 #[derive(Default)]
@@ -394,18 +395,9 @@ pub(crate) struct PlanMemo {
 }
 
 impl PlanMemo {
-    /// The plan kept for face `f` if it was planned at `base_level` from the same control
-    /// points and sides.
-    fn get(
-        &self,
-        base_level: usize,
-        f: usize,
-        cp: &ControlGrid,
-        sides: [bool; 4],
-    ) -> Option<&Plan> {
-        if self.base_level != base_level {
-            return None;
-        }
+    /// The plan kept for face `f` if it was planned from the same control points and sides
+    /// (the caller checks that the memo is of the same base level and space).
+    fn get(&self, f: usize, cp: &ControlGrid, sides: [bool; 4]) -> Option<&Plan> {
         let (old, old_sides, plan) = self.faces.get(f)?.as_ref()?;
         let same = old
             .iter()
@@ -629,7 +621,7 @@ pub(super) fn tessellate(
             return Some((None, None, false));
         };
         let sides = boundary_sides(f);
-        if let Some(plan) = old_memo.and_then(|m| m.get(k0, f, &cp, sides)) {
+        if let Some(plan) = old_memo.and_then(|m| m.get(f, &cp, sides)) {
             return Some((Some(plan.clone()), None, true));
         }
         let plan = plan_face(f, &mut Source::Regular(cp))?;
