@@ -17,6 +17,10 @@ const LIMIT: i64 = 1 << 40;
 const SMALL: i64 = 1 << 26;
 /// ...and rows within this one (2^16, twice the largest image side) take 64-bit arithmetic.
 const SMALL_ROWS: i64 = 1 << 16;
+/// Rows whose spans [`Triangle::for_each_span`] finds together.
+const SPAN_ROWS: usize = 16;
+/// Integers below this magnitude, and the sums of two of them, are exact in `f64`.
+const EXACT_F64: i64 = 1 << 51;
 
 /// Snaps a pixel coordinate to the sub-pixel grid; `None` if it is not finite or too large.
 pub(crate) fn snap(v: f64) -> Option<i64> {
@@ -222,6 +226,23 @@ fn floor_div_small(a: i64, b: i64, inv: f64) -> i64 {
     q
 }
 
+/// `floor(a / b)` for integers `|a| < EXACT_F64` and `b` in `256..EXACT_F64` held in `f64`,
+/// given `inv`, `1 / b` rounded: the rounded quotient is within one of the answer, and one
+/// exact test each way settles it (the products are integers below 2^53). Without branches
+/// or integer conversions, so that rows vectorise.
+#[inline(always)]
+fn floor_div_f64(a: f64, b: f64, inv: f64) -> f64 {
+    // Round to the nearest integer by adding and removing 1.5 * 2^52 (|a / b| < 2^43), then
+    // down.
+    const ROUND: f64 = 6_755_399_441_055_744.0;
+    let t = a * inv;
+    let r = (t + ROUND) - ROUND;
+    let mut q = r - if r > t { 1.0 } else { 0.0 };
+    q -= if q * b > a { 1.0 } else { 0.0 };
+    q += if (q + 1.0) * b <= a { 1.0 } else { 0.0 };
+    q
+}
+
 impl Triangle {
     /// The triangle through snapped vertices `v` with attributes `attr` at them; `None` if it
     /// has no area. The attributes' planes go through the exact vertex positions `exact` (pixel
@@ -395,7 +416,10 @@ impl Triangle {
     }
 
     /// Calls `f(j, start, end)` with the columns inside for each row `j` in `rows`, finding
-    /// the edges once.
+    /// the edges once. Rows go in groups of [`SPAN_ROWS`], whose spans are found together
+    /// ([`Triangle::spans_f64`]) where the edge functions are small enough, one by one in
+    /// integers elsewhere; `f` is called from one place (a second call site kept the
+    /// attribute fill it inlines from being compiled with wide vectors).
     #[inline(always)]
     pub fn for_each_span(
         &self,
@@ -405,14 +429,104 @@ impl Triangle {
     ) {
         let edges = self.edges();
         let small = self.small();
-        for j in rows {
-            let (a, b) = if small && j.abs() < SMALL_ROWS {
-                Self::span_small(&edges, j, width)
-            } else {
-                Self::span_wide(&edges, j, width)
-            };
-            f(j, a, b);
+        let mut spans = [(0i64, 0i64); SPAN_ROWS];
+        let mut j0 = rows.start;
+        while j0 < rows.end {
+            let j1 = rows.end.min(j0 + SPAN_ROWS as i64);
+            if !Self::spans_f64(&edges, j0, j1, width, &mut spans) {
+                for (span, j) in spans.iter_mut().zip(j0..j1) {
+                    *span = if small && j.abs() < SMALL_ROWS {
+                        Self::span_small(&edges, j, width)
+                    } else {
+                        Self::span_wide(&edges, j, width)
+                    };
+                }
+            }
+            for (&(a, b), j) in spans.iter().zip(j0..j1) {
+                f(j, a, b);
+            }
+            j0 = j1;
         }
+    }
+
+    /// The spans of rows `j0..j1` (at most [`SPAN_ROWS`]) into `out`, in double precision:
+    /// every row's edge function values, quotients and their products are integers below
+    /// [`EXACT_F64`], so each step is exact, and the rows are independent lanes without
+    /// branches (vectorised). `false`, leaving `out` alone, where some value is too large.
+    #[inline(always)]
+    fn spans_f64(
+        edges: &[Edge; 3],
+        j0: i64,
+        j1: i64,
+        width: i64,
+        out: &mut [(i64, i64); SPAN_ROWS],
+    ) -> bool {
+        let half = SUBPIXEL / 2;
+        let mut lo = [0.0f64; SPAN_ROWS];
+        let mut hi = [width as f64; SPAN_ROWS];
+        // Row `j0 + r` as a lane number.
+        let lane: [f64; SPAN_ROWS] = std::array::from_fn(|r| r as f64);
+        for e in edges {
+            let (px, py) = (e.p[0], e.p[1]);
+            let (dx, dy) = (e.d[0], e.d[1]);
+            // E(i) = dx (ry - py) - dy (256 i + 128 - px) = k - m i, with k linear in the
+            // row: its largest magnitude over the rows is at the first or the last.
+            let k_at = |j: i64| {
+                dx.checked_mul(j.checked_mul(SUBPIXEL)?.checked_add(half - py)?)?
+                    .checked_sub(dy.checked_mul(half - px)?)
+            };
+            let (Some(k_first), Some(k_last)) = (k_at(j0), k_at(j1 - 1)) else {
+                return false;
+            };
+            let Some(m) = dy.checked_mul(SUBPIXEL) else {
+                return false;
+            };
+            let step = dx.saturating_mul(SUBPIXEL);
+            if [k_first, k_last, m, step]
+                .iter()
+                .any(|v| v.unsigned_abs() >= EXACT_F64 as u64)
+            {
+                return false;
+            }
+            let (k0, step, b) = (k_first as f64, step as f64, m.abs() as f64);
+            let k = |r: usize| k0 + step * lane[r];
+            if m == 0 {
+                // A horizontal edge: the whole row is inside or outside.
+                for r in 0..SPAN_ROWS {
+                    let kr = k(r);
+                    let inside = kr > 0.0 || (kr == 0.0 && e.include);
+                    hi[r] = if inside { hi[r] } else { f64::NEG_INFINITY };
+                }
+            } else if m > 0 {
+                for r in 0..SPAN_ROWS {
+                    let kr = k(r);
+                    let stop = if e.include {
+                        floor_div_f64(kr, b, e.inv) + 1.0
+                    } else {
+                        -floor_div_f64(-kr, b, e.inv)
+                    };
+                    hi[r] = hi[r].min(stop);
+                }
+            } else {
+                for r in 0..SPAN_ROWS {
+                    let kr = k(r);
+                    let first = if e.include {
+                        -floor_div_f64(kr, b, e.inv)
+                    } else {
+                        floor_div_f64(-kr, b, e.inv) + 1.0
+                    };
+                    lo[r] = lo[r].max(first);
+                }
+            }
+        }
+        for r in 0..(j1 - j0) as usize {
+            out[r] = if lo[r] < hi[r] {
+                (lo[r] as i64, hi[r] as i64)
+            } else {
+                (0, 0)
+            };
+        }
+        true
     }
 
     /// A row's span in 64-bit integers: exact when the vertices lie within [`SMALL`] and
@@ -730,6 +844,53 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn spans_found_together_match_wide_integer_spans() {
+        // Triangles of every size from a pixel to far beyond the double-precision path's
+        // range, near and far from the origin, with rows through, beside and far from them.
+        let mut bits = super::super::test_random(0x9e37_79b9);
+        let (mut checked_f64, mut checked_integers) = (0, 0);
+        for n in 0..3000 {
+            let scale = [1.0, 50.0, 3000.0, 1e6, 3e9][n % 5];
+            let centre = [
+                (bits() % 4000) as f64 - 1000.0,
+                (bits() % 4000) as f64 - 1000.0,
+            ];
+            let mut next = || (bits() % 1_000_000) as f64 / 1e6 - 0.5;
+            let v = [0, 1, 2].map(|_| p(centre[0] + scale * next(), centre[1] + scale * next()));
+            let Some(t) = Triangle::new(v, [[0.0; 2]; 3], [[0.0; 4]; 3]) else {
+                continue;
+            };
+            let e = t.edges();
+            let (r0, r1) = t.rows();
+            let first = r0.max(-70_000) - 3;
+            let rows = first..r1.min(first + 60) + 3;
+            for width in [1, 600, 40_000] {
+                let mut got = Vec::new();
+                t.for_each_span(rows.clone(), width, |j, a, b| got.push((j, a, b)));
+                let want: Vec<_> = rows
+                    .clone()
+                    .map(|j| {
+                        let (a, b) = Triangle::span_wide(&e, j, width);
+                        (j, a, b)
+                    })
+                    .collect();
+                assert_eq!(got, want, "{v:?} width {width}");
+                let mut spans = [(0, 0); SPAN_ROWS];
+                if Triangle::spans_f64(&e, first, first + 16, width, &mut spans) {
+                    checked_f64 += 1;
+                } else {
+                    checked_integers += 1;
+                }
+            }
+        }
+        // Both paths were taken, the double-precision one by most groups of rows.
+        assert!(
+            checked_f64 > 3000 && checked_integers > 100,
+            "{checked_f64} {checked_integers}"
+        );
     }
 
     /// Far from the image's origin and on a steep gradient, the single-precision attributes
