@@ -416,10 +416,12 @@ impl Triangle {
     }
 
     /// Calls `f(j, start, end)` with the columns inside for each row `j` in `rows`, finding
-    /// the edges once. Rows go in groups of [`SPAN_ROWS`], whose spans are found together
-    /// ([`Triangle::spans_f64`]) where the edge functions are small enough, one by one in
-    /// integers elsewhere; `f` is called from one place (a second call site kept the
-    /// attribute fill it inlines from being compiled with wide vectors).
+    /// the edges once. Rows go in groups of up to [`SPAN_ROWS`], whose spans are found
+    /// together ([`Triangle::spans_f64`]) where the edge functions are small enough, one by
+    /// one in integers elsewhere and in groups of one or two rows (a small triangle's share of
+    /// a band, for which the groups' set-up cost more than they saved). `f` is called from one
+    /// place: a second call site kept the attribute fill it inlines from being compiled with
+    /// wide vectors.
     #[inline(always)]
     pub fn for_each_span(
         &self,
@@ -433,7 +435,7 @@ impl Triangle {
         let mut j0 = rows.start;
         while j0 < rows.end {
             let j1 = rows.end.min(j0 + SPAN_ROWS as i64);
-            if !Self::spans_f64(&edges, j0, j1, width, &mut spans) {
+            if j1 - j0 < 3 || !Self::spans_f64(&edges, j0, j1, width, &mut spans) {
                 for (span, j) in spans.iter_mut().zip(j0..j1) {
                     *span = if small && j.abs() < SMALL_ROWS {
                         Self::span_small(&edges, j, width)
@@ -452,7 +454,8 @@ impl Triangle {
     /// The spans of rows `j0..j1` (at most [`SPAN_ROWS`]) into `out`, in double precision:
     /// every row's edge function values, quotients and their products are integers below
     /// [`EXACT_F64`], so each step is exact, and the rows are independent lanes without
-    /// branches (vectorised). `false`, leaving `out` alone, where some value is too large.
+    /// branches, computed four at a time (vectorised). `false`, leaving `out` alone, where
+    /// some value is too large.
     #[inline(always)]
     fn spans_f64(
         edges: &[Edge; 3],
@@ -464,8 +467,9 @@ impl Triangle {
         let half = SUBPIXEL / 2;
         let mut lo = [0.0f64; SPAN_ROWS];
         let mut hi = [width as f64; SPAN_ROWS];
-        // Row `j0 + r` as a lane number.
+        // Row `j0 + r` as a lane number; whole vectors of four lanes are computed.
         let lane: [f64; SPAN_ROWS] = std::array::from_fn(|r| r as f64);
+        let lanes = ((j1 - j0) as usize).next_multiple_of(4).min(SPAN_ROWS);
         for e in edges {
             let (px, py) = (e.p[0], e.p[1]);
             let (dx, dy) = (e.d[0], e.d[1]);
@@ -492,13 +496,13 @@ impl Triangle {
             let k = |r: usize| k0 + step * lane[r];
             if m == 0 {
                 // A horizontal edge: the whole row is inside or outside.
-                for r in 0..SPAN_ROWS {
+                for r in 0..lanes {
                     let kr = k(r);
                     let inside = kr > 0.0 || (kr == 0.0 && e.include);
                     hi[r] = if inside { hi[r] } else { f64::NEG_INFINITY };
                 }
             } else if m > 0 {
-                for r in 0..SPAN_ROWS {
+                for r in 0..lanes {
                     let kr = k(r);
                     let stop = if e.include {
                         floor_div_f64(kr, b, e.inv) + 1.0
@@ -508,7 +512,7 @@ impl Triangle {
                     hi[r] = hi[r].min(stop);
                 }
             } else {
-                for r in 0..SPAN_ROWS {
+                for r in 0..lanes {
                     let kr = k(r);
                     let first = if e.include {
                         -floor_div_f64(kr, b, e.inv)
