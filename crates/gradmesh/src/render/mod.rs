@@ -1100,15 +1100,41 @@ fn shade_row<const FRESH: bool>(
         (alpha > 0.0).then_some((attr, alpha))
     };
     if shading.space == ColourSpace::Lab {
-        // In runs: first the pixels this layer shows (whole blocks of a fresh layer at once),
+        // In runs: first the pixels this layer shows (whole blocks under nothing at once),
         // then their colours all at once (vectorised), then compositing.
+        let gather = |j: usize, n: &mut usize, run: &mut Run, opaque: &[bool]| {
+            if let Some((attr, alpha)) = shown(j, opaque) {
+                for c in 0..3 {
+                    run.colour[c][*n] = attr[c];
+                }
+                run.alpha[*n] = alpha;
+                run.pixel[*n] = (row + j) as u32;
+                *n += 1;
+            }
+        };
         let mut i = cols.start;
         while i < cols.end {
             let mut n = 0;
             while i < cols.end && n < RUN {
-                if FRESH && i + BLOCK <= cols.end && n + BLOCK <= RUN {
-                    let k = row + i;
-                    if let Some(at) = whole_block(&coverage[i..], &covered[k..], &attributes[k..]) {
+                if i + BLOCK > cols.end || n + BLOCK > RUN {
+                    gather(i, &mut n, run, opaque);
+                    i += 1;
+                    continue;
+                }
+                // A block under nothing: a fresh layer's, or one no layer above has drawn
+                // into (compositing under a clear pixel gives what a fresh layer writes).
+                // Whole, it is gathered at once; otherwise pixel by pixel, without testing
+                // a block again from each of them.
+                let k = row + i;
+                let clear = FRESH
+                    || colour[k..k + BLOCK]
+                        .iter()
+                        .fold(true, |all, c| all & (c[3] == 0.0));
+                let whole = clear
+                    .then(|| whole_block(&coverage[i..], &covered[k..], &attributes[k..]))
+                    .flatten();
+                match whole {
+                    Some(at) => {
                         for (m, a) in at.iter().enumerate() {
                             for c in 0..3 {
                                 run.colour[c][n + m] = a[c];
@@ -1117,19 +1143,14 @@ fn shade_row<const FRESH: bool>(
                             run.pixel[n + m] = (k + m) as u32;
                         }
                         n += BLOCK;
-                        i += BLOCK;
-                        continue;
+                    }
+                    None => {
+                        for j in i..i + BLOCK {
+                            gather(j, &mut n, run, opaque);
+                        }
                     }
                 }
-                if let Some((attr, alpha)) = shown(i, opaque) {
-                    for c in 0..3 {
-                        run.colour[c][n] = attr[c];
-                    }
-                    run.alpha[n] = alpha;
-                    run.pixel[n] = (row + i) as u32;
-                    n += 1;
-                }
-                i += 1;
+                i += BLOCK;
             }
             shading.converter.convert(&run.colour, n, &mut run.rgb);
             for m in 0..n {
