@@ -360,45 +360,52 @@ fn deterministic_with_default_pool() {
 
 /// A layer drawn where no layer above it shows anything gives the bytes it gives alone: the
 /// drawing composites under a clear pixel exactly as it draws a layer with nothing above it
-/// (both are fast paths of their own).
+/// (both are fast paths of their own), in Lab and in sRGB with colours in range (each space
+/// has its own pixel loop).
 #[test]
 fn a_layer_under_nothing_draws_as_it_does_alone() {
     let below = grid(6, 5, [0.0, 0.0, 120.0, 100.0], 0.2, soft_colour);
     let above = star(Point::new(30.0, 40.0), 28.0);
-    let both = doc(vec![below.clone(), above.clone()]);
-    let opts = RenderOptions::fit(&both, 500);
-    let draw = |layers: Vec<GradientMesh>| {
-        let mut out = vec![0u8; 4 * opts.width as usize * opts.height as usize];
-        gradmesh::render::render_document_into(&doc(layers), &opts, &mut out).unwrap();
-        out
-    };
-    let (together, alone, top) = (
-        draw(vec![below, above.clone()]),
-        draw(vec![both.layers[0].clone()]),
-        draw(vec![above]),
-    );
-    // Pixels within two of one the star shows (its outline's coverage may be below what
-    // eight bits show).
-    let (w, h) = (opts.width as i64, opts.height as i64);
-    let near_top = |x: i64, y: i64| {
-        (y - 2..=y + 2).any(|v| {
-            (x - 2..=x + 2).any(|u| {
-                (0..w).contains(&u) && (0..h).contains(&v) && top[4 * (v * w + u) as usize + 3] > 0
-            })
-        })
-    };
-    let mut compared = 0;
-    for (i, (t, a)) in together.chunks(4).zip(alone.chunks(4)).enumerate() {
-        let (x, y) = (i as i64 % w, i as i64 / w);
-        if !near_top(x, y) {
-            assert_eq!(t, a, "pixel ({x}, {y})");
-            compared += usize::from(a[3] == 255);
-        }
+    // The sRGB loop without gamut search takes colours in range only.
+    for p in below.points.iter().chain(&above.points) {
+        let rgb = ColourSpace::Lab.convert(ColourSpace::Srgb, p.colour);
+        assert!(rgb.iter().all(|c| (0.0..=1.0).contains(c)), "{rgb:?}");
     }
-    // Most of the grid lies outside the star.
-    assert!(compared > 50_000, "{compared}");
-    // And the star does cover part of it.
-    assert!(together != alone);
+    for space in [None, Some(ColourSpace::Srgb)] {
+        let mut opts = RenderOptions::fit(&doc(vec![below.clone(), above.clone()]), 500);
+        opts.colour_space_override = space;
+        let draw = |layers: Vec<GradientMesh>| {
+            let mut out = vec![0u8; 4 * opts.width as usize * opts.height as usize];
+            gradmesh::render::render_document_into(&doc(layers), &opts, &mut out).unwrap();
+            out
+        };
+        let together = draw(vec![below.clone(), above.clone()]);
+        let (alone, top) = (draw(vec![below.clone()]), draw(vec![above.clone()]));
+        // Pixels within two of one the star shows (its outline's coverage may be below what
+        // eight bits show).
+        let (w, h) = (opts.width as i64, opts.height as i64);
+        let near_top = |x: i64, y: i64| {
+            (y - 2..=y + 2).any(|v| {
+                (x - 2..=x + 2).any(|u| {
+                    (0..w).contains(&u)
+                        && (0..h).contains(&v)
+                        && top[4 * (v * w + u) as usize + 3] > 0
+                })
+            })
+        };
+        let mut compared = 0;
+        for (i, (t, a)) in together.chunks(4).zip(alone.chunks(4)).enumerate() {
+            let (x, y) = (i as i64 % w, i as i64 / w);
+            if !near_top(x, y) {
+                assert_eq!(t, a, "{space:?}: pixel ({x}, {y})");
+                compared += usize::from(a[3] == 255);
+            }
+        }
+        // Most of the grid lies outside the star.
+        assert!(compared > 50_000, "{space:?}: {compared}");
+        // And the star does cover part of it.
+        assert!(together != alone);
+    }
 }
 
 /// Reference mode is converged: one more level changes no 16-bit channel by more than one step

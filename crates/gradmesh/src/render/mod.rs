@@ -1174,28 +1174,32 @@ fn shade_row<const FRESH: bool>(
                 put(colour, opaque, row + i, rgb, alpha)
             };
             let mut i = cols.start;
-            if FRESH {
-                // Most blocks of a fresh layer's interior are whole ([`whole_block`]) and in
-                // range: each pixel's colour is then its attributes with an alpha of one,
-                // copied without branches (vectorised). The `vs_cairo` scene's drawing took
-                // a fifth less time.
-                while i + BLOCK <= cols.end {
-                    let k = row + i;
-                    let whole = whole_block(&coverage[i..], &covered[k..], &attributes[k..])
-                        .filter(|at| at.iter().fold(true, |all, a| all & in_unit_f32(a)));
-                    if let Some(at) = whole {
-                        for (dst, a) in colour[k..k + BLOCK].iter_mut().zip(at) {
-                            *dst = [a[0], a[1], a[2], 1.0];
-                        }
-                        opaque[k..k + BLOCK].fill(true);
-                        made_opaque += BLOCK;
-                    } else {
-                        for j in i..i + BLOCK {
-                            made_opaque += one(j, opaque, colour);
-                        }
+            // Most blocks of a fresh layer's interior are whole ([`whole_block`]) and in range:
+            // each pixel's colour is then its attributes with an alpha of one, copied without
+            // branches (vectorised). The `vs_cairo` scene's drawing took a fifth less time.
+            // The same holds under pixels no layer above has drawn into.
+            while i + BLOCK <= cols.end {
+                let k = row + i;
+                let clear = FRESH
+                    || colour[k..k + BLOCK]
+                        .iter()
+                        .fold(true, |all, c| all & (c[3] == 0.0));
+                let whole = clear
+                    .then(|| whole_block(&coverage[i..], &covered[k..], &attributes[k..]))
+                    .flatten()
+                    .filter(|at| at.iter().fold(true, |all, a| all & in_unit_f32(a)));
+                if let Some(at) = whole {
+                    for (dst, a) in colour[k..k + BLOCK].iter_mut().zip(at) {
+                        *dst = [a[0], a[1], a[2], 1.0];
                     }
-                    i += BLOCK;
+                    opaque[k..k + BLOCK].fill(true);
+                    made_opaque += BLOCK;
+                } else {
+                    for j in i..i + BLOCK {
+                        made_opaque += one(j, opaque, colour);
+                    }
                 }
+                i += BLOCK;
             }
             for j in i..cols.end {
                 made_opaque += one(j, opaque, colour);
