@@ -1126,14 +1126,8 @@ fn shade_row<const FRESH: bool>(
                 // Whole, it is gathered at once; otherwise pixel by pixel, without testing
                 // a block again from each of them.
                 let k = row + i;
-                let clear = FRESH
-                    || colour[k..k + BLOCK]
-                        .iter()
-                        .fold(true, |all, c| all & (c[3] == 0.0));
-                let whole = clear
-                    .then(|| whole_block(&coverage[i..], &covered[k..], &attributes[k..]))
-                    .flatten();
-                match whole {
+                let under = (!FRESH).then(|| &colour[k..]);
+                match whole_block(&coverage[i..], &covered[k..], &attributes[k..], under) {
                     Some(at) => {
                         for (m, a) in at.iter().enumerate() {
                             for c in 0..3 {
@@ -1180,13 +1174,8 @@ fn shade_row<const FRESH: bool>(
             // The same holds under pixels no layer above has drawn into.
             while i + BLOCK <= cols.end {
                 let k = row + i;
-                let clear = FRESH
-                    || colour[k..k + BLOCK]
-                        .iter()
-                        .fold(true, |all, c| all & (c[3] == 0.0));
-                let whole = clear
-                    .then(|| whole_block(&coverage[i..], &covered[k..], &attributes[k..]))
-                    .flatten()
+                let under = (!FRESH).then(|| &colour[k..]);
+                let whole = whole_block(&coverage[i..], &covered[k..], &attributes[k..], under)
                     .filter(|at| at.iter().fold(true, |all, a| all & in_unit_f32(a)));
                 if let Some(at) = whole {
                     for (dst, a) in colour[k..k + BLOCK].iter_mut().zip(at) {
@@ -1234,19 +1223,28 @@ fn shade_row<const FRESH: bool>(
     made_opaque
 }
 
-/// The attributes of the first [`BLOCK`] pixels of a row of a fresh layer if all of them are
-/// whole: covered by the outline and by triangles, and opaque. The per-pixel loops would
-/// composite each of them with an alpha of one.
+/// The attributes of the first [`BLOCK`] pixels of a row if all of them are whole: covered by
+/// the outline and by triangles, opaque, and with nothing under them (the layer is the band's
+/// first, or `under`, the band's colour there, is still clear: compositing under a clear pixel
+/// gives what a first layer writes). The per-pixel loops would composite each of them with an
+/// alpha of one.
 #[inline(always)]
 fn whole_block<'a>(
     coverage: &[f32],
     covered: &[bool],
     attributes: &'a [[f32; 4]],
+    under: Option<&[[f32; 4]]>,
 ) -> Option<&'a [[f32; 4]; BLOCK]> {
+    // `fold` with `&`: without an early exit the tests vectorise.
+    if let Some(under) = under {
+        let under: &[[f32; 4]; BLOCK] = under[..BLOCK].try_into().expect("a block");
+        if !under.iter().fold(true, |all, c| all & (c[3] == 0.0)) {
+            return None;
+        }
+    }
     let cov: &[f32; BLOCK] = coverage[..BLOCK].try_into().expect("a block");
     let cv: &[bool; BLOCK] = covered[..BLOCK].try_into().expect("a block");
     let at: &[[f32; 4]; BLOCK] = attributes[..BLOCK].try_into().expect("a block");
-    // `fold` with `&`: without an early exit the test vectorises.
     let whole = (0..BLOCK).fold(true, |all, j| {
         all & (cov[j] == 1.0) & cv[j] & (at[j][3] >= 1.0)
     });
