@@ -660,6 +660,7 @@ impl Scratch {
                 colour: [[0.0; RUN]; 3],
                 pixel: [0; RUN],
                 alpha: [0.0; RUN],
+                block: [false; RUN],
                 rgb: [[0.0; 3]; RUN],
             }),
         }
@@ -673,6 +674,9 @@ struct Run {
     colour: [[f32; RUN]; 3],
     pixel: [u32; RUN],
     alpha: [f32; RUN],
+    /// Whether a whole block ([`whole_block`]) starts at this entry: its pixels follow the
+    /// first's, and their alpha is one (only the first entry's `pixel` is written).
+    block: [bool; RUN],
     rgb: [[f32; 3]; RUN],
 }
 
@@ -1109,6 +1113,7 @@ fn shade_row<const FRESH: bool>(
                 }
                 run.alpha[*n] = alpha;
                 run.pixel[*n] = (row + j) as u32;
+                run.block[*n] = false;
                 *n += 1;
             }
         };
@@ -1133,9 +1138,9 @@ fn shade_row<const FRESH: bool>(
                             for c in 0..3 {
                                 run.colour[c][n + m] = a[c];
                             }
-                            run.alpha[n + m] = 1.0;
-                            run.pixel[n + m] = (k + m) as u32;
                         }
+                        run.pixel[n] = k as u32;
+                        run.block[n] = true;
                         n += BLOCK;
                     }
                     None => {
@@ -1147,9 +1152,22 @@ fn shade_row<const FRESH: bool>(
                 i += BLOCK;
             }
             shading.converter.convert(&run.colour, n, &mut run.rgb);
-            for m in 0..n {
-                let (k, rgb, alpha) = (run.pixel[m] as usize, run.rgb[m], run.alpha[m]);
-                made_opaque += put(colour, opaque, k, rgb, alpha);
+            let mut m = 0;
+            while m < n {
+                let k = run.pixel[m] as usize;
+                if run.block[m] {
+                    // What `put` gives a pixel under nothing with an alpha of one, a block at
+                    // once (vectorised).
+                    for (dst, rgb) in colour[k..k + BLOCK].iter_mut().zip(&run.rgb[m..m + BLOCK]) {
+                        *dst = [rgb[0], rgb[1], rgb[2], 1.0];
+                    }
+                    opaque[k..k + BLOCK].fill(true);
+                    made_opaque += BLOCK;
+                    m += BLOCK;
+                } else {
+                    made_opaque += put(colour, opaque, k, run.rgb[m], run.alpha[m]);
+                    m += 1;
+                }
             }
         }
     } else {
