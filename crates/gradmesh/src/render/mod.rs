@@ -1003,26 +1003,17 @@ fn encode_row_plain<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]]) {
 }
 
 /// [`encode_row_plain`] with dither noise, for row `y`. In a block of opaque pixels the hashes
-/// come first (64-bit, one at a time), then the noise and the encoding, which vectorise.
+/// come first (64-bit, one at a time), then the noise ([`output::dither_noise_block`]) and the
+/// encoding, which vectorise.
 // Always inlined: see `wide_vectors`.
 #[inline(always)]
 fn encode_row_dithered<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]], y: u32) {
     let opaque = |start: usize, c: &[[f32; 4]; BLOCK], dst: &mut [P; 4 * BLOCK]| {
-        let mut hashes = [0u64; BLOCK];
-        for (k, h) in hashes.iter_mut().enumerate() {
-            *h = output::dither_hash((start + k) as u32, y);
-        }
-        for ((px, c), &h) in dst.chunks_exact_mut(4).zip(c).zip(&hashes) {
-            let noise = output::noise_of_hash(h);
-            // Alpha, at least 1, encodes as 1.
-            for ch in 0..4 {
-                let v = if P::SATURATES {
-                    c[ch]
-                } else {
-                    c[ch].clamp(0.0, 1.0)
-                };
-                px[ch] = P::encode_branchless(v, noise[ch]);
-            }
+        let noise = output::dither_noise_block::<BLOCK, { 4 * BLOCK }>(start as u32, y);
+        // Alpha, at least 1, encodes as 1.
+        for ((px, &v), &noise) in dst.iter_mut().zip(c.as_flattened()).zip(&noise) {
+            let v = if P::SATURATES { v } else { v.clamp(0.0, 1.0) };
+            *px = P::encode_branchless(v, noise);
         }
     };
     let one = |i: usize, c: &[f32; 4], px: &mut [P]| {

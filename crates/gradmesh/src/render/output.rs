@@ -124,6 +124,33 @@ pub(crate) fn noise_of_hash(v: u64) -> [f32; 4] {
     ]
 }
 
+/// [`dither_noise`] of `N` pixels of row `y` from column `x`, channel `ch` of pixel `k` at
+/// `4 k + ch`, with the same bits: each channel's two bytes are a 16-bit word of the hash,
+/// summed in lanes (vectorised) rather than byte by byte.
+#[inline(always)]
+pub(crate) fn dither_noise_block<const N: usize, const C: usize>(x: u32, y: u32) -> [f32; C] {
+    const { assert!(C == 4 * N) };
+    let mut hashes = [0u64; N];
+    for (k, h) in hashes.iter_mut().enumerate() {
+        *h = dither_hash(x + k as u32, y);
+    }
+    // Each channel's two bytes summed in 16-bit lanes of the hash (no carry crosses lanes).
+    const LOW: u64 = 0x00ff_00ff_00ff_00ff;
+    let mut sums = [0u32; C];
+    for (w, &h) in sums.chunks_exact_mut(4).zip(&hashes) {
+        let s = (h & LOW) + ((h >> 8) & LOW);
+        for (ch, w) in w.iter_mut().enumerate() {
+            *w = ((s >> (16 * ch)) & 0xffff) as u32;
+        }
+    }
+    let mut noise = [0.0f32; C];
+    for (n, &w) in noise.iter_mut().zip(&sums) {
+        // `tpdf` of `noise_of_hash`: the sum of two bytes is exact in `f32`.
+        *n = (w as f32 + 1.0) / 256.0 - 1.0;
+    }
+    noise
+}
+
 /// An RGBA image with `f32` channels: straight (non-premultiplied) alpha, sRGB-encoded colour
 /// in `0..=1`, rows top to bottom.
 #[derive(Clone, Debug, PartialEq)]
@@ -338,6 +365,20 @@ mod tests {
         check::<u8>();
         check::<u16>();
         check::<f32>();
+    }
+
+    #[test]
+    fn noise_of_a_block_is_each_pixels_noise() {
+        let mut random = crate::render::test_random(7);
+        for _ in 0..2000 {
+            let (x, y) = ((random() >> 40) as u32, (random() >> 40) as u32);
+            let block = dither_noise_block::<8, 32>(x, y);
+            for k in 0..8 {
+                let one = dither_noise(x + k as u32, y);
+                let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&block[4 * k..4 * k + 4]), bits(&one));
+            }
+        }
     }
 
     #[test]
