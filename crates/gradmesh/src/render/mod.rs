@@ -1122,6 +1122,11 @@ fn shade_row<const FRESH: bool>(
                 // Whole, it is gathered at once; otherwise pixel by pixel, without testing
                 // a block again from each of them.
                 let k = row + i;
+                // A block that layers above have made opaque shows nothing of this one.
+                if !FRESH && all_true(&opaque[k..]) {
+                    i += BLOCK;
+                    continue;
+                }
                 let under = (!FRESH).then(|| &colour[k..]);
                 match whole_block(&coverage[i..], &covered[k..], &attributes[k..], under) {
                     Some(at) => {
@@ -1183,6 +1188,10 @@ fn shade_row<const FRESH: bool>(
             // The same holds under pixels no layer above has drawn into.
             while i + BLOCK <= cols.end {
                 let k = row + i;
+                if !FRESH && all_true(&opaque[k..]) {
+                    i += BLOCK;
+                    continue;
+                }
                 let under = (!FRESH).then(|| &colour[k..]);
                 let whole = whole_block(&coverage[i..], &covered[k..], &attributes[k..], under)
                     .filter(|at| at.iter().fold(true, |all, a| all & in_unit_f32(a)));
@@ -1258,6 +1267,13 @@ fn whole_block<'a>(
         all & (cov[j] == 1.0) & cv[j] & (at[j][3] >= 1.0)
     });
     whole.then_some(at)
+}
+
+/// Whether the first [`BLOCK`] flags of `flags` are all set.
+#[inline(always)]
+fn all_true(flags: &[bool]) -> bool {
+    let block: &[bool; BLOCK] = flags[..BLOCK].try_into().expect("a block");
+    block.iter().fold(true, |all, &f| all & f)
 }
 
 /// Whether the three colour channels of `a` lie in `0..=1`.
