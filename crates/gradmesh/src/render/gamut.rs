@@ -313,6 +313,18 @@ impl RunConverter {
                     *v = srgb_encode_unit_f32(self.table, *v);
                 }
             }
+            // Most runs lie wholly inside the gamut: their colours are then their encodings,
+            // without a test and a branch per colour. `fold` with `&`: it vectorises.
+            let unit = |v: f32| (0.0..=1.0).contains(&v);
+            let inside = (0..n).fold(true, |all, m| {
+                all & unit(lin[0][m]) & unit(lin[1][m]) & unit(lin[2][m])
+            });
+            if inside {
+                for (m, o) in out[..n].iter_mut().enumerate() {
+                    *o = [encoded[0][m], encoded[1][m], encoded[2][m]];
+                }
+                return;
+            }
         }
         // Colours outside the gamut in single precision, converted after the loop.
         let mut outside = [0u8; RUN];
