@@ -1117,16 +1117,16 @@ fn shade_row<const FRESH: bool>(
                     i += 1;
                     continue;
                 }
-                // A block under nothing: a fresh layer's, or one no layer above has drawn
-                // into (compositing under a clear pixel gives what a fresh layer writes).
-                // Whole, it is gathered at once; otherwise pixel by pixel, without testing
-                // a block again from each of them.
                 let k = row + i;
                 // A block that layers above have made opaque shows nothing of this one.
                 if !FRESH && all_true(&opaque[k..]) {
                     i += BLOCK;
                     continue;
                 }
+                // A block under nothing: a fresh layer's, or one no layer above has drawn
+                // into (compositing under a clear pixel gives what a fresh layer writes).
+                // Whole, it is gathered at once; otherwise pixel by pixel, without testing
+                // a block again from each of them.
                 let under = (!FRESH).then(|| &colour[k..]);
                 match whole_block(&coverage[i..], &covered[k..], &attributes[k..], under) {
                     Some(at) => {
@@ -1188,6 +1188,7 @@ fn shade_row<const FRESH: bool>(
             // The same holds under pixels no layer above has drawn into.
             while i + BLOCK <= cols.end {
                 let k = row + i;
+                // Hidden by layers above.
                 if !FRESH && all_true(&opaque[k..]) {
                     i += BLOCK;
                     continue;
