@@ -1152,13 +1152,7 @@ fn shade_row<const FRESH: bool>(
             while m < n {
                 let k = run.pixel[m] as usize;
                 if run.block[m] {
-                    // What `put` gives a pixel under nothing with an alpha of one, a block at
-                    // once (vectorised).
-                    for (dst, rgb) in colour[k..k + BLOCK].iter_mut().zip(&run.rgb[m..m + BLOCK]) {
-                        *dst = [rgb[0], rgb[1], rgb[2], 1.0];
-                    }
-                    opaque[k..k + BLOCK].fill(true);
-                    made_opaque += BLOCK;
+                    made_opaque += put_opaque_block(colour, opaque, k, &run.rgb[m..]);
                     m += BLOCK;
                 } else {
                     made_opaque += put(colour, opaque, k, run.rgb[m], run.alpha[m]);
@@ -1197,11 +1191,7 @@ fn shade_row<const FRESH: bool>(
                 let whole = whole_block(&coverage[i..], &covered[k..], &attributes[k..], under)
                     .filter(|at| at.iter().fold(true, |all, a| all & in_unit_f32(a)));
                 if let Some(at) = whole {
-                    for (dst, a) in colour[k..k + BLOCK].iter_mut().zip(at) {
-                        *dst = [a[0], a[1], a[2], 1.0];
-                    }
-                    opaque[k..k + BLOCK].fill(true);
-                    made_opaque += BLOCK;
+                    made_opaque += put_opaque_block(colour, opaque, k, at);
                 } else {
                     for j in i..i + BLOCK {
                         made_opaque += one(j, opaque, colour);
@@ -1268,6 +1258,24 @@ fn whole_block<'a>(
         all & (cov[j] == 1.0) & cv[j] & (at[j][3] >= 1.0)
     });
     whole.then_some(at)
+}
+
+/// Writes the first [`BLOCK`] colours of `rgb` (three channels or more) with an alpha of one
+/// to the band's pixels from `k`, and marks them opaque: what `under` gives pixels under
+/// nothing with an alpha of one, a block at once without branches (vectorised). Returns
+/// [`BLOCK`], the pixels made opaque.
+#[inline(always)]
+fn put_opaque_block<const C: usize>(
+    colour: &mut [[f32; 4]],
+    opaque: &mut [bool],
+    k: usize,
+    rgb: &[[f32; C]],
+) -> usize {
+    for (dst, c) in colour[k..k + BLOCK].iter_mut().zip(&rgb[..BLOCK]) {
+        *dst = [c[0], c[1], c[2], 1.0];
+    }
+    opaque[k..k + BLOCK].fill(true);
+    BLOCK
 }
 
 /// Whether the first [`BLOCK`] flags of `flags` are all set.
