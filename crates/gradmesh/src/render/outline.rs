@@ -169,10 +169,12 @@ pub(crate) fn outline(
 }
 
 /// Removes pairs of identical segments run in opposite directions (the two sides of a
-/// discontinuous edge), keeping the order of the rest.
+/// discontinuous edge), keeping the order of the rest. Segments are grouped by sorting their
+/// ends' bits: hashing them (SipHash) cost about 2.5 % of preparing the Tucan artwork.
 fn cancel_opposite(lines: Vec<Line>) -> Vec<Line> {
     type Key = ([u64; 2], [u64; 2]);
     let bits = |p: [f64; 2]| p.map(f64::to_bits);
+    // A segment's ends in a fixed order, and +1 or -1 for its direction.
     let key = |l: &Line| -> (Key, i32) {
         let (a, b) = (bits(l.p0), bits(l.p1));
         if a <= b {
@@ -181,26 +183,29 @@ fn cancel_opposite(lines: Vec<Line>) -> Vec<Line> {
             ((b, a), -1)
         }
     };
-    let mut net: HashMap<Key, i32> = HashMap::with_capacity(lines.len());
-    for l in &lines {
-        let (k, s) = key(l);
-        *net.entry(k).or_insert(0) += s;
-    }
-    if net.len() * 2 == lines.len() && net.values().all(|&v| v == 0) {
-        return Vec::new();
+    let mut order: Vec<(Key, i32, u32)> = lines
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let (k, s) = key(l);
+            (k, s, i as u32)
+        })
+        .collect();
+    order.sort_unstable_by_key(|&(k, _, i)| (k, i));
+    // In each group of the same segment, the net count's first segments of its direction (in
+    // their original order) are kept: the others cancel in pairs.
+    let mut keep = vec![false; lines.len()];
+    for group in order.chunk_by(|a, b| a.0 == b.0) {
+        let net: i32 = group.iter().map(|&(_, s, _)| s).sum();
+        let kept = group.iter().filter(|&&(_, s, _)| s == net.signum());
+        for &(_, _, i) in kept.take(net.unsigned_abs() as usize) {
+            keep[i as usize] = true;
+        }
     }
     lines
         .into_iter()
-        .filter(|l| {
-            let (k, s) = key(l);
-            let n = net.get_mut(&k).expect("counted");
-            if *n != 0 && n.signum() == s {
-                *n -= s;
-                true
-            } else {
-                false
-            }
-        })
+        .zip(keep)
+        .filter_map(|(l, k)| k.then_some(l))
         .collect()
 }
 
