@@ -391,14 +391,19 @@ pub(crate) struct PlanMemo {
     /// The working space the colours are in (a layer whose space changed, and whose points
     /// are black, would have the same bits in another space).
     space: Option<ColourSpace>,
-    faces: Vec<Option<(ControlGrid, [bool; 4], Plan)>>,
+    faces: Vec<Option<Remembered>>,
 }
+
+/// A regular face's control points, which of its sides lie on the outline, and its plan.
+/// Boxed: the control points are 768 bytes, which every face's result moved around even
+/// where nothing is remembered (a tenth of planning a 90,000-face level went to copies).
+type Remembered = Box<(ControlGrid, [bool; 4], Plan)>;
 
 impl PlanMemo {
     /// The plan kept for face `f` if it was planned from the same control points and sides
     /// (the caller checks that the memo is of the same base level and space).
     fn get(&self, f: usize, cp: &ControlGrid, sides: [bool; 4]) -> Option<&Plan> {
-        let (old, old_sides, plan) = self.faces.get(f)?.as_ref()?;
+        let (old, old_sides, plan) = &**self.faces.get(f)?.as_ref()?;
         let same = old
             .iter()
             .flatten()
@@ -615,7 +620,6 @@ pub(super) fn tessellate(
     let old_memo = memo
         .as_deref()
         .filter(|m| m.base_level == k0 && m.space == Some(th.space) && m.faces.len() == nf);
-    type Remembered = (ControlGrid, [bool; 4], Plan);
     let planned: Vec<(Option<Plan>, Option<Remembered>, bool)> = each_face(nf, |f| {
         let Some(cp) = regular_patch_with(level, d, f, |v| regular[v]) else {
             return Some((None, None, false));
@@ -625,7 +629,7 @@ pub(super) fn tessellate(
             return Some((Some(plan.clone()), None, true));
         }
         let plan = plan_face(f, &mut Source::Regular(cp))?;
-        let remembered = memo.is_some().then(|| (cp, sides, plan.clone()));
+        let remembered = memo.is_some().then(|| Box::new((cp, sides, plan.clone())));
         Some((Some(plan), remembered, false))
     })?;
     let reused_plans = planned.iter().filter(|p| p.2).count();
