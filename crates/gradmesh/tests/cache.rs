@@ -126,3 +126,61 @@ fn cached_renders_equal_fresh_ones_and_prepare_only_what_changed() {
         [true, true, true, true, true, false]
     );
 }
+
+/// Renders with the cache into `P` pixels and from scratch, asserts they agree, and returns
+/// how many bands the cached render drew.
+fn drawn_bands<P: gradmesh::render::OutputPixel + Default + PartialEq>(
+    doc: &Document,
+    opts: &RenderOptions,
+    cache: &mut RenderCache,
+) -> usize {
+    let n = 4 * (opts.width * opts.height) as usize;
+    let (mut cached, mut fresh) = (vec![P::default(); n], vec![P::default(); n]);
+    let info = render_document_into_cached(doc, opts, cache, &mut cached).unwrap();
+    render_document_into(doc, opts, &mut fresh).unwrap();
+    assert!(cached == fresh, "cached and fresh renders differ");
+    info.drawn_bands
+}
+
+#[test]
+fn edits_draw_again_only_the_bands_they_change() {
+    let mut doc = tucan();
+    let opts = options(&doc, 300);
+    let all = (opts.height as usize).div_ceil(16);
+    let mut cache = RenderCache::new();
+    assert_eq!(drawn_bands::<u8>(&doc, &opts, &mut cache), all);
+    assert_eq!(drawn_bands::<u8>(&doc, &opts, &mut cache), 0);
+
+    // Points moved and recoloured in every layer, inside and on the outline; each cached
+    // render equals one from scratch (into a buffer that held nothing), and some edits draw
+    // only part of the image.
+    let mut partial = 0;
+    for l in 0..doc.layers.len() {
+        let count = doc.layers[l].points.len();
+        for k in [0, count / 3, count / 2, count - 1] {
+            let p = &mut doc.layers[l].points[k];
+            p.position.x += 0.7;
+            p.position.y -= 0.4;
+            let moved = drawn_bands::<u8>(&doc, &opts, &mut cache);
+            let p = &mut doc.layers[l].points[k];
+            p.colour[1] += 6.0;
+            let recoloured = drawn_bands::<u8>(&doc, &opts, &mut cache);
+            for n in [moved, recoloured] {
+                assert!(n > 0, "layer {l} point {k}: nothing drawn again");
+                partial += usize::from(n < all);
+            }
+        }
+    }
+    assert!(partial >= 8, "only {partial} edits drew part of the image");
+
+    // Another pixel type, then back: every band the first time, then only what changed.
+    assert_eq!(drawn_bands::<f32>(&doc, &opts, &mut cache), all);
+    assert_eq!(drawn_bands::<f32>(&doc, &opts, &mut cache), 0);
+    assert_eq!(drawn_bands::<u8>(&doc, &opts, &mut cache), all);
+
+    // A drawing option draws everything again, the layers being kept.
+    let mut opts = opts;
+    opts.dither = !opts.dither;
+    assert_eq!(drawn_bands::<u8>(&doc, &opts, &mut cache), all);
+    assert_eq!(drawn_bands::<u8>(&doc, &opts, &mut cache), 0);
+}

@@ -107,6 +107,52 @@ pub(crate) struct PreparedLayer {
     pub colours_in_unit_range: bool,
 }
 
+impl PreparedLayer {
+    /// Marks in `changed` (a flag per band) the bands where this layer may draw differently
+    /// from `old`, its last preparation: those whose triangles or outline lines differ in any
+    /// bit, and those within `reach[band]` of a boundary segment that changed (the farthest
+    /// its outline pixels there took their colour from when last drawn); every band when something the whole layer's drawing reads did (its colour
+    /// space, columns or colour bounds, or the boundary segments' grid).
+    pub fn mark_changed_bands(&self, old: &PreparedLayer, reach: &[f64], changed: &mut [bool]) {
+        let bounds = |b: &Option<Bounds>| b.map(|b| b.map(|r| r.map(f32::to_bits)));
+        let segments = self.nearest.changed_rows(&old.nearest);
+        let Some(segments) = segments.filter(|_| {
+            self.space == old.space
+                && self.columns == old.columns
+                && bounds(&self.bounds) == bounds(&old.bounds)
+                && self.colours_in_unit_range == old.colours_in_unit_range
+        }) else {
+            changed.fill(true);
+            return;
+        };
+        let line = |l: &Line| [l.p0, l.p1].map(|p| p.map(f64::to_bits));
+        for (band, changed) in changed.iter_mut().enumerate() {
+            if *changed {
+                continue;
+            }
+            // A changed segment farther from every pixel centre of the band than the answers
+            // its outline pixels took (plus a pixel, for rounding) changes none of them.
+            let (top, bottom) = ((band * BAND) as f64 + 0.5, ((band + 1) * BAND) as f64 - 0.5);
+            let margin = reach[band] + 1.0;
+            let near = segments
+                .iter()
+                .any(|&[lo, hi]| lo <= bottom + margin && hi >= top - margin);
+            let (a, b) = (self.triangle_bins.get(band), old.triangle_bins.get(band));
+            let (mut x, mut y) = (self.triangles.cursor(), old.triangles.cursor());
+            let same_triangles = a.len() == b.len()
+                && a.iter()
+                    .zip(b)
+                    .all(|(&i, &j)| x.get(i as usize).same_bits(y.get(j as usize)));
+            let (a, b) = (self.line_bins.get(band), old.line_bins.get(band));
+            let same_lines = a.len() == b.len()
+                && a.iter()
+                    .zip(b)
+                    .all(|(&i, &j)| line(&self.lines[i as usize]) == line(&old.lines[j as usize]));
+            *changed = near || !(same_triangles && same_lines);
+        }
+    }
+}
+
 /// The mesh with its colours converted to `space` (so that they are interpolated there).
 fn in_space(mesh: &GradientMesh, space: ColourSpace) -> GradientMesh {
     let mut m = mesh.clone();

@@ -359,6 +359,9 @@ pub struct RenderInfo {
     pub warnings: Vec<Warning>,
     /// Time spent on each stage.
     pub timings: RenderTimings,
+    /// How many bands of rows were drawn: all of them, unless a [`RenderCache`] held the last
+    /// image and some bands draw exactly as before (they are copied from it).
+    pub drawn_bands: usize,
 }
 
 /// Renders `doc` into a new `f32` image: straight alpha, sRGB-encoded colour.
@@ -407,6 +410,10 @@ pub fn render_document_into<P: OutputPixel>(
 /// layer (its grid density and samples), which depends on its sixteen control points alone:
 /// a layer whose points or colours moved reuses the first, and plans again only the faces
 /// within reach of what moved ([`LayerInfo::reused_faces`]).
+///
+/// It keeps the last image drawn, too: a band of rows where no layer's triangles, outline or
+/// outline colours changed is copied from it instead of drawn ([`RenderInfo::drawn_bands`]).
+/// The output buffer may be a fresh one each time; the copy costs one image of memory.
 #[derive(Default)]
 pub struct RenderCache {
     /// Local refinements by shape of neighbourhood, for all layers (cleared when they pile
@@ -420,6 +427,19 @@ pub struct RenderCache {
     /// it has been prepared again (edited), which a layer prepared again after an edit takes
     /// for the faces the edit left alone.
     plans: Vec<adaptive::PlanMemo>,
+    /// The last image drawn through the cache: bands that no layer draws differently are
+    /// copied from it rather than drawn again.
+    drawn: Option<Drawn>,
+}
+
+/// An image [`render_document_into_cached`] drew, and the options it drew it with.
+struct Drawn {
+    opts: RenderOptions,
+    /// A `Vec<P>` of the [`OutputPixel`] type it was drawn in.
+    pixels: Box<dyn std::any::Any + Send + Sync>,
+    /// Per band, then per layer: the farthest an outline pixel's colour was taken from (the
+    /// nearest boundary point, see [`nearest`]); negative infinity where none was.
+    reach: Vec<f64>,
 }
 
 /// The most shapes of local refinement a [`RenderCache`] keeps: a few hundred kilobytes each
@@ -485,6 +505,12 @@ fn render<P: OutputPixel>(
             cache.layers.clear();
             cache.plans.clear();
         }
+        // A document with other layers, or other drawing options, draws every band again.
+        if cache.layers.len() != doc.layers.len()
+            || cache.drawn.as_ref().is_some_and(|d| d.opts != *opts)
+        {
+            cache.drawn = None;
+        }
         cache.layers.resize_with(doc.layers.len(), || None);
         cache.plans.resize_with(doc.layers.len(), Default::default);
         if cache.shapes.len() > MAX_CACHED_SHAPES {
@@ -525,13 +551,50 @@ fn render<P: OutputPixel>(
     drop(memos);
     let reused: Vec<bool> = fresh.iter().map(Option::is_none).collect();
     let kept: Vec<layer::Prepared>;
+    let bands = h.div_ceil(BAND);
+    // Entries per band of `Drawn::reach`.
+    let nl = doc.layers.len().max(1);
+    // The bands to draw, and the last image drawn through the cache (taken out while drawing:
+    // a drawing cut short leaves none), whose other bands are as they would be drawn.
+    let mut changed = vec![true; bands];
+    let mut last: Option<Drawn> = None;
+    let mut last_slot: Option<&mut Option<Drawn>> = None;
     let prepared: Vec<&layer::Prepared> = match cache {
         Some(cache) => {
+            last = cache.drawn.take();
+            if last.is_some() {
+                changed.fill(false);
+            }
             for (i, fresh) in fresh.into_iter().enumerate() {
                 if let Some(p) = fresh {
+                    let reach: Vec<f64> = match &last {
+                        Some(d) => (0..bands).map(|b| d.reach[b * nl + i]).collect(),
+                        None => Vec::new(),
+                    };
+                    match cache.layers[i].as_ref().map(|(_, old)| (&old.1, &p.1)) {
+                        Some((Some(old), Some(new))) if last.is_some() => {
+                            new.mark_changed_bands(old, &reach, &mut changed)
+                        }
+                        Some((None, None)) => {}
+                        _ => changed.fill(true),
+                    }
                     cache.layers[i] = Some((doc.layers[i].clone(), p));
                 }
             }
+            // Drawn in another pixel type or size (or never): every band is drawn.
+            let same_kind = last
+                .as_ref()
+                .and_then(|d| d.pixels.downcast_ref::<Vec<P>>())
+                .is_some_and(|p| p.len() == out.len());
+            if !same_kind {
+                changed.fill(true);
+                last = Some(Drawn {
+                    opts: opts.clone(),
+                    pixels: Box::new(out.to_vec()),
+                    reach: vec![f64::NEG_INFINITY; bands * nl],
+                });
+            }
+            last_slot = Some(&mut cache.drawn);
             // Every entry was just filled or matched.
             cache
                 .layers
@@ -549,6 +612,8 @@ fn render<P: OutputPixel>(
     };
     let mut info = RenderInfo::default();
     let mut layers: Vec<&PreparedLayer> = Vec::new();
+    // The document's index of each layer drawn (those with nothing to draw are left out).
+    let mut layer_of: Vec<usize> = Vec::new();
     for ((layer_info, layer, warnings), reused) in prepared.into_iter().zip(reused) {
         let mut layer_info = layer_info.clone();
         if reused {
@@ -558,7 +623,10 @@ fn render<P: OutputPixel>(
         }
         info.layers.push(layer_info);
         info.warnings.extend(warnings.iter().cloned());
-        layers.extend(layer.as_ref());
+        if let Some(layer) = layer {
+            layer_of.push(info.layers.len() - 1);
+            layers.push(layer);
+        }
     }
     info.timings.prepare = start.elapsed();
 
@@ -572,21 +640,51 @@ fn render<P: OutputPixel>(
         [rgb[0] * a, rgb[1] * a, rgb[2] * a, a].map(|v| v as f32)
     });
     let start = Instant::now();
-    out.par_chunks_mut(4 * w * BAND)
-        .enumerate()
-        .for_each(|(band, chunk)| {
-            Scratch::with(w, |scratch| {
-                let job = Band {
-                    wide: false,
-                    index: band,
-                    out: chunk,
-                    layers: &layers,
-                    opts,
-                    background,
-                };
-                draw_band_dispatched(job, scratch)
-            });
+    // Draws a band, and puts in `reach` (per layer of the document) what [`Band::reach`] gets.
+    let draw = |band: usize, chunk: &mut [P], reach: &mut [f64]| {
+        let mut drawn_reach = vec![f64::NEG_INFINITY; layers.len()];
+        Scratch::with(w, |scratch| {
+            let job = Band {
+                wide: false,
+                index: band,
+                out: chunk,
+                layers: &layers,
+                opts,
+                background,
+                reach: &mut drawn_reach,
+            };
+            draw_band_dispatched(job, scratch)
         });
+        reach.fill(f64::NEG_INFINITY);
+        for (&i, r) in layer_of.iter().zip(drawn_reach) {
+            reach[i] = r;
+        }
+    };
+    let chunks = out.par_chunks_mut(4 * w * BAND).enumerate();
+    match last.as_mut() {
+        // Bands drawn again are kept for the next render; the others are taken from the last.
+        Some(Drawn { pixels, reach, .. }) => {
+            let pixels = pixels
+                .downcast_mut::<Vec<P>>()
+                .expect("kept in this pixel type above");
+            chunks
+                .zip(pixels.par_chunks_mut(4 * w * BAND))
+                .zip(reach.par_chunks_mut(nl))
+                .for_each(|(((band, chunk), last), reach)| {
+                    if changed[band] {
+                        draw(band, chunk, reach);
+                        last.copy_from_slice(chunk);
+                    } else {
+                        chunk.copy_from_slice(last);
+                    }
+                })
+        }
+        None => chunks.for_each(|(band, chunk)| draw(band, chunk, &mut vec![0.0; nl])),
+    }
+    info.drawn_bands = changed.iter().filter(|&&c| c).count();
+    if let Some(slot) = last_slot {
+        *slot = last;
+    }
     info.timings.draw = start.elapsed();
     Ok(info)
 }
@@ -775,6 +873,8 @@ struct Band<'a, P> {
     layers: &'a [&'a PreparedLayer],
     opts: &'a RenderOptions,
     background: Option<[f32; 4]>,
+    /// Receives, per layer, the farthest an outline pixel's colour was taken from.
+    reach: &'a mut [f64],
 }
 
 /// Draws every layer into a band. Inlined into the two compilations of
@@ -788,7 +888,9 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
         layers,
         opts,
         background,
+        reach,
     } = job;
+    reach.fill(f64::NEG_INFINITY);
     let w = opts.width as usize;
     let y0 = band * BAND;
     let rows = out.len() / (4 * w);
@@ -817,7 +919,7 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
     let mut opaque = 0usize;
     // Whether no layer above has drawn into the band: its pixels are then all clear.
     let mut fresh = true;
-    for layer in layers.iter().rev() {
+    for (li, layer) in layers.iter().enumerate().rev() {
         if opaque == w * rows {
             break;
         }
@@ -838,8 +940,10 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
         };
         let bounds = layer.bounds.as_ref().unwrap_or(&triangles::UNBOUNDED);
         // Outline colours of a layer with quadratic sides are clamped as its triangles are.
+        let farthest = std::cell::Cell::new(f64::NEG_INFINITY);
         let nearest = |p: [f64; 2]| {
-            let a = layer.nearest.attributes_at(p)?;
+            let (a, distance) = layer.nearest.attributes_and_distance_at(p)?;
+            farthest.set(farthest.get().max(distance));
             Some(match layer.bounds {
                 Some(b) => each4(|k| a[k].clamp(b[0][k], b[1][k])),
                 None => a,
@@ -894,6 +998,7 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
             };
         }
         fresh = false;
+        reach[li] = farthest.get();
     }
     if let Some(bg) = background {
         for dst in colour.iter_mut() {

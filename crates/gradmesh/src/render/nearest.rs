@@ -33,6 +33,41 @@ pub(crate) struct NearestSegments {
 }
 
 impl NearestSegments {
+    /// The row spans (lowest and highest `y`, pixels) of the segments that differ in any bit
+    /// between `old` and this, in either, where they may change only the answers near them:
+    /// both hold as many segments, in the same grid. `None` otherwise. (Answers are exact
+    /// minima of distance, then of index, but the ring search may stop at a tie it would see
+    /// in another grid.)
+    pub fn changed_rows(&self, old: &NearestSegments) -> Option<Vec<[f64; 2]>> {
+        let grid = |n: &NearestSegments| {
+            (
+                n.origin.map(f64::to_bits),
+                n.cell.to_bits(),
+                n.nx,
+                n.ny,
+                n.segments.len(),
+            )
+        };
+        if grid(self) != grid(old) {
+            return None;
+        }
+        let bits = |s: &Segment| {
+            (
+                [s.a, s.b].map(|p| p.map(f64::to_bits)),
+                [s.ca, s.cb, s.bump].map(|c| c.map(f32::to_bits)),
+            )
+        };
+        let rows = |s: &Segment| [s.a[1].min(s.b[1]), s.a[1].max(s.b[1])];
+        Some(
+            self.segments
+                .iter()
+                .zip(&old.segments)
+                .filter(|(a, b)| bits(a) != bits(b))
+                .flat_map(|(a, b)| [rows(a), rows(b)])
+                .collect(),
+        )
+    }
+
     pub fn new(segments: Vec<Segment>) -> Self {
         if segments.is_empty() {
             return NearestSegments::default();
@@ -112,7 +147,13 @@ impl NearestSegments {
     }
 
     /// The attributes at the point of the boundary nearest to `p`, or `None` without boundary.
+    #[cfg(test)]
     pub fn attributes_at(&self, p: [f64; 2]) -> Option<[f32; 4]> {
+        self.attributes_and_distance_at(p).map(|(a, _)| a)
+    }
+
+    /// [`NearestSegments::attributes_at`], and the distance to that point.
+    pub fn attributes_and_distance_at(&self, p: [f64; 2]) -> Option<([f32; 4], f64)> {
         if self.segments.is_empty() {
             return None;
         }
@@ -169,14 +210,14 @@ impl NearestSegments {
                 }
             }
         }
-        let (_, s, t) = best?;
+        let (d2, s, t) = best?;
         let seg = &self.segments[s];
         let t = t as f32;
         let mut out = [0.0f32; 4];
         for k in 0..4 {
             out[k] = seg.ca[k] + t * (seg.cb[k] - seg.ca[k]) + seg.bump[k] * (t * (1.0 - t));
         }
-        Some(out)
+        Some((out, d2.sqrt()))
     }
 }
 

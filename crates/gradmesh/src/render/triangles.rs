@@ -358,6 +358,17 @@ impl Triangle {
         })
     }
 
+    /// Whether `other` is this triangle bit for bit: it then draws the same pixels.
+    pub fn same_bits(&self, other: &Triangle) -> bool {
+        let bits = |t: &Triangle| {
+            [t.at_origin, t.gx, t.gy, t.qxx, t.qxy, t.qyy].map(|a| a.map(f32::to_bits))
+        };
+        self.v == other.v
+            && self.rows == other.rows
+            && self.clamped == other.clamped
+            && bits(self) == bits(other)
+    }
+
     /// The snapped vertices, in sub-pixel units.
     #[cfg(test)]
     pub fn vertices(&self) -> [[i64; 2]; 3] {
