@@ -34,21 +34,11 @@ pub(crate) struct NearestSegments {
 
 impl NearestSegments {
     /// The row spans (lowest and highest `y`, pixels) of the segments that differ in any bit
-    /// between `old` and this, in either, where they may change only the answers near them:
-    /// both hold as many segments, in the same grid. `None` otherwise. (Answers are exact
-    /// minima of distance, then of index, but the ring search may stop at a tie it would see
-    /// in another grid.)
+    /// between `old` and this, in either, when both hold as many: the others keep their
+    /// indices, and an answer (the least distance, then the least index, whatever the grid)
+    /// changes only where a changed segment is as near. `None` for another count.
     pub fn changed_rows(&self, old: &NearestSegments) -> Option<Vec<[f64; 2]>> {
-        let grid = |n: &NearestSegments| {
-            (
-                n.origin.map(f64::to_bits),
-                n.cell.to_bits(),
-                n.nx,
-                n.ny,
-                n.segments.len(),
-            )
-        };
-        if grid(self) != grid(old) {
+        if self.segments.len() != old.segments.len() {
             return None;
         }
         let bits = |s: &Segment| {
@@ -204,7 +194,10 @@ impl NearestSegments {
                         .min(right - p[0])
                         .min(p[1] - top)
                         .min(bottom - p[1]);
-                    if d2 <= margin * margin {
+                    // Strictly nearer (with room for rounding): an unseen edge at the same
+                    // distance with a lower index would win, and the answer would then depend
+                    // on the grid, which depends on every edge.
+                    if d2 < margin * margin * (1.0 - 1e-9) {
                         break;
                     }
                 }
