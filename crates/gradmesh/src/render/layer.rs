@@ -858,3 +858,65 @@ pub(crate) fn prepare(
     };
     Ok((info, Some(layer), warnings))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A layer of nothing but boundary segments: one every 8 rows, down the image.
+    fn segments_only(bands: usize, shift: Option<usize>) -> PreparedLayer {
+        let segments = (0..2 * bands)
+            .map(|k| {
+                let y = 8.0 * k as f64;
+                let x = if shift == Some(k) { 10.5 } else { 10.0 };
+                Segment {
+                    a: [x, y],
+                    b: [x, y + 8.0],
+                    ca: [50.0, 0.0, 0.0, 1.0],
+                    cb: [50.0, 0.0, 0.0, 1.0],
+                    bump: [0.0; 4],
+                }
+            })
+            .collect();
+        PreparedLayer {
+            space: ColourSpace::Lab,
+            triangles: TriangleList::default(),
+            triangle_bins: Bins::new(bands, &[]),
+            lines: Vec::new(),
+            line_bins: Bins::new(bands, &[]),
+            nearest: NearestSegments::new(segments),
+            columns: (0, 20),
+            bounds: None,
+            colours_in_unit_range: false,
+        }
+    }
+
+    /// A changed boundary segment marks the bands whose outline pixels took colours from
+    /// within its reach, and no other.
+    #[test]
+    fn changed_segments_mark_the_bands_within_reach() {
+        let bands = 8;
+        let (old, new) = (segments_only(bands, None), segments_only(bands, Some(9)));
+        let changed = |reach: f64| {
+            let mut changed = vec![false; bands];
+            new.mark_changed_bands(&old, &vec![reach; bands], &mut changed);
+            changed
+        };
+        // Segment 9 spans rows 72 to 80; band 4 holds rows 64 to 79, band 5 rows 80 to 95.
+        assert_eq!(changed(f64::NEG_INFINITY), [false; 8]);
+        let near = [false, false, false, false, true, true, false, false];
+        assert_eq!(changed(0.5), near);
+        assert_eq!(
+            changed(8.0),
+            [false, false, false, true, true, true, false, false]
+        );
+        // Another count of segments: every band.
+        let fewer = PreparedLayer {
+            nearest: NearestSegments::new(Vec::new()),
+            ..segments_only(bands, None)
+        };
+        let mut changed = vec![false; bands];
+        fewer.mark_changed_bands(&old, &[0.5; 8], &mut changed);
+        assert_eq!(changed, [true; 8]);
+    }
+}
