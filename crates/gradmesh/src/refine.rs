@@ -90,6 +90,27 @@ impl Refinement {
         r
     }
 
+    /// Takes `base` as the base level instead, keeping every level built, if it refines to the
+    /// same topology and stencils (the same split topology, sharpness and rules: an edit of
+    /// positions, colours, handles or multi-resolution edits); gives it back otherwise.
+    pub fn rebase(&mut self, base: BaseMesh) -> Result<(), Box<BaseMesh>> {
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        let (a, b) = (&self.base, &base);
+        let same = a.topology == b.topology
+            && a.source_point == b.source_point
+            && bits(&a.edge_sharpness) == bits(&b.edge_sharpness)
+            && bits(&a.vertex_sharpness) == bits(&b.vertex_sharpness)
+            && a.boundary == b.boundary
+            && a.creasing == b.creasing
+            && a.interpolate_positions == b.interpolate_positions
+            && a.first_step == b.first_step;
+        if !same {
+            return Err(Box::new(base));
+        }
+        self.base = base;
+        Ok(())
+    }
+
     /// Refines further so that level `depth` exists.
     pub fn extend_to(&mut self, depth: usize) {
         if depth >= 1 && self.levels.is_empty() {
@@ -153,11 +174,17 @@ impl Refinement {
     /// # Panics
     /// If `base` has another topology than the one refined.
     pub fn evaluate_with(&self, base: &BaseMesh) -> RefinedMesh {
+        self.evaluate_to(base, self.levels.len())
+    }
+
+    /// [`Refinement::evaluate_with`] down to level `depth` only (or the deepest built).
+    pub fn evaluate_to(&self, base: &BaseMesh, depth: usize) -> RefinedMesh {
+        let depth = depth.min(self.levels.len());
         let mut levels = vec![base.data.clone()];
-        if !self.levels.is_empty() {
+        if depth >= 1 {
             levels.push(self.first_level_data(base));
         }
-        for k in 1..self.levels.len() {
+        for k in 1..depth {
             let next = self.next_level_data_with(base, k, &levels[k]);
             levels.push(next);
         }
@@ -350,4 +377,57 @@ fn first_data(base: &BaseMesh) -> Vec<VertexData> {
 fn has_semi_sharp(level: &Level) -> bool {
     let semi = |&s: &f64| rules::is_sharp(s) && !rules::is_infinite(s);
     level.edge_sharpness.iter().any(semi) || level.vertex_sharpness.iter().any(semi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::EdgeKind;
+    use kurbo::{Point, Vec2};
+
+    /// A 3 x 2 grid of quads with colours.
+    fn grid() -> GradientMesh {
+        let mut m = GradientMesh::new(ColourSpace::Lab);
+        for j in 0..3 {
+            for i in 0..4 {
+                let (x, y) = (i as f64, j as f64);
+                m.add_point(Point::new(10.0 * x, 10.0 * y), [50.0 + x, 5.0 * y, -x * y]);
+            }
+        }
+        for j in 0..2 {
+            for i in 0..3 {
+                let a = 4 * j + i;
+                m.add_face(vec![a, a + 1, a + 5, a + 4]);
+            }
+        }
+        m
+    }
+
+    /// An edit of the data (a point moved and recoloured, a handle turned) keeps the levels
+    /// built and evaluates as a refinement made afresh; another topology or sharpness is
+    /// refused.
+    #[test]
+    fn rebase_keeps_levels_for_data_edits_only() {
+        let mesh = grid();
+        let (mut kept, _) = Refinement::new(&mesh, 3).unwrap();
+        let mut edited = mesh.clone();
+        edited.points[5].position.x += 1.5;
+        edited.points[6].colour[1] -= 7.0;
+        edited.handles.insert((5, 6), Vec2::new(2.0, 1.0));
+        let (base, _) = BaseMesh::new(&edited).unwrap();
+        assert!(kept.rebase(base).is_ok());
+        let (fresh, _) = Refinement::new(&edited, 3).unwrap();
+        assert_eq!(kept.depth(), 3);
+        assert_eq!(kept.evaluate(), fresh.evaluate());
+
+        let mut creased = mesh.clone();
+        creased.set_edge(5, 6, EdgeKind::Crease, Some(2.0));
+        let (base, _) = BaseMesh::new(&creased).unwrap();
+        assert!(kept.rebase(base).is_err());
+        let mut more = mesh.clone();
+        more.add_point(Point::new(40.0, 30.0), [50.0, 0.0, 0.0]);
+        more.add_face(vec![10, 11, 12]);
+        let (base, _) = BaseMesh::new(&more).unwrap();
+        assert!(kept.rebase(base).is_err());
+    }
 }

@@ -12,7 +12,7 @@ pub const INVALID: u32 = u32::MAX;
 pub(crate) const PARALLEL_MIN_CORNERS: usize = 1 << 12;
 
 /// The connectivity of a polygon mesh with boundaries.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Topology {
     pub(crate) vertex_count: usize,
     pub(crate) face_offsets: Vec<u32>,

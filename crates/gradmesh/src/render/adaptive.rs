@@ -392,6 +392,9 @@ pub(crate) struct PlanMemo {
     /// are black, would have the same bits in another space).
     space: Option<ColourSpace>,
     faces: Vec<Option<Remembered>>,
+    /// The layer's refinement at its last preparation (the topology of its levels and the
+    /// stencils between them), which an edit that keeps the topology takes again.
+    pub refinement: Option<Refinement>,
 }
 
 /// A regular face's control points, which of its sides lie on the outline, and its plan.

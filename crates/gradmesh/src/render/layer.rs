@@ -11,6 +11,7 @@ use crate::limit;
 use crate::mesh::GradientMesh;
 use crate::refine::{RefinedMesh, Refinement};
 use crate::topology::Topology;
+use crate::validate::BaseMesh;
 use crate::validate::VertexData;
 
 use super::adaptive;
@@ -691,7 +692,7 @@ pub(crate) fn prepare(
     opts: &RenderOptions,
     xf: &ToPixels,
     shapes: &ShapeCache,
-    memo: Option<&mut adaptive::PlanMemo>,
+    mut memo: Option<&mut adaptive::PlanMemo>,
 ) -> Result<Prepared, Error> {
     if mesh.faces.is_empty() {
         return Ok((LayerInfo::default(), None, Vec::new()));
@@ -702,8 +703,17 @@ pub(crate) fn prepare(
     let original_space = mesh.colour_space;
     let mesh = in_space(mesh, space);
     // Level 1 only: the fast path of a dense layer starts there, and each path builds the
-    // levels it needs (level 2 of a 10,000-face mesh alone took about 100 ms).
-    let (mut refinement, warnings) = Refinement::new(&mesh, 1).map_err(|e| e.in_layer(index))?;
+    // levels it needs (level 2 of a 10,000-face mesh alone took about 100 ms). An edited layer
+    // whose topology stayed takes the levels its last preparation built.
+    let (base, warnings) = BaseMesh::new(&mesh).map_err(|e| e.in_layer(index))?;
+    let kept = memo.as_deref_mut().and_then(|m| m.refinement.take());
+    let mut refinement = match kept {
+        Some(mut r) => match r.rebase(base) {
+            Ok(()) => r,
+            Err(base) => Refinement::from_base(*base, 1),
+        },
+        None => Refinement::from_base(base, 1),
+    };
     // The edits' colours stay in the space they were written in.
     refinement.set_edit_colour_space(original_space);
     let warnings = warnings
@@ -713,7 +723,7 @@ pub(crate) fn prepare(
             ..w
         })
         .collect();
-    let mut data = refinement.evaluate();
+    let mut data = refinement.evaluate_to(refinement.base(), 1);
     timings.refine = start.elapsed();
     let start = Instant::now();
     let (w, h) = (opts.width as i64, opts.height as i64);
@@ -733,7 +743,7 @@ pub(crate) fn prepare(
             (w, h),
             adaptive::Kept {
                 shapes,
-                plans: memo,
+                plans: memo.as_deref_mut(),
             },
         )
     };
@@ -807,6 +817,9 @@ pub(crate) fn prepare(
         OUTLINE_TOLERANCE_PX
     };
     let all_lines = outline(refinement.level(k), &loops, &control_px, tolerance);
+    if let Some(memo) = memo {
+        memo.refinement = Some(refinement);
+    }
     let mut lines = Vec::new();
     let mut line_ranges = Vec::new();
     let (mut c0, mut c1) = (f64::INFINITY, f64::NEG_INFINITY);

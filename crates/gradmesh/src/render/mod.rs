@@ -411,6 +411,9 @@ pub fn render_document_into<P: OutputPixel>(
 /// a layer whose points or colours moved reuses the first, and plans again only the faces
 /// within reach of what moved ([`LayerInfo::reused_faces`]).
 ///
+/// An edited layer whose topology (faces, edge kinds and sharpness, rules) stayed also keeps
+/// the topology of its refinement levels and their stencils ([`crate::Refinement::rebase`]).
+///
 /// It keeps the last image drawn, too: a band of rows where no layer's triangles, outline or
 /// outline colours changed is copied from it instead of drawn ([`RenderInfo::drawn_bands`]).
 /// The output buffer may be a fresh one each time; the copy costs one image of memory.
