@@ -664,24 +664,22 @@ fn render<P: OutputPixel>(
         }
     };
     let chunks = out.par_chunks_mut(4 * w * BAND).enumerate();
-    match last.as_mut() {
+    let kept = last
+        .as_mut()
+        .and_then(|Drawn { pixels, reach, .. }| Some((pixels.downcast_mut::<Vec<P>>()?, reach)));
+    match kept {
         // Bands drawn again are kept for the next render; the others are taken from the last.
-        Some(Drawn { pixels, reach, .. }) => {
-            let pixels = pixels
-                .downcast_mut::<Vec<P>>()
-                .expect("kept in this pixel type above");
-            chunks
-                .zip(pixels.par_chunks_mut(4 * w * BAND))
-                .zip(reach.par_chunks_mut(nl))
-                .for_each(|(((band, chunk), last), reach)| {
-                    if changed[band] {
-                        draw(band, chunk, reach);
-                        last.copy_from_slice(chunk);
-                    } else {
-                        chunk.copy_from_slice(last);
-                    }
-                })
-        }
+        Some((pixels, reach)) => chunks
+            .zip(pixels.par_chunks_mut(4 * w * BAND))
+            .zip(reach.par_chunks_mut(nl))
+            .for_each(|(((band, chunk), last), reach)| {
+                if changed[band] {
+                    draw(band, chunk, reach);
+                    last.copy_from_slice(chunk);
+                } else {
+                    chunk.copy_from_slice(last);
+                }
+            }),
         None => chunks.for_each(|(band, chunk)| draw(band, chunk, &mut vec![0.0; nl])),
     }
     info.drawn_bands = changed.iter().filter(|&&c| c).count();
