@@ -112,8 +112,9 @@ impl PreparedLayer {
     /// Marks in `changed` (a flag per band) the bands where this layer may draw differently
     /// from `old`, its last preparation: those whose triangles or outline lines differ in any
     /// bit, and those within `reach[band]` of a boundary segment that changed (the farthest
-    /// its outline pixels there took their colour from when last drawn); every band when something the whole layer's drawing reads did (its colour
-    /// space, columns or colour bounds, or the boundary segments' grid).
+    /// its outline pixels there took their colour from when last drawn); every band when
+    /// something the whole layer's drawing reads changed (its colour space, columns or colour
+    /// bounds, or the number of boundary segments).
     pub fn mark_changed_bands(&self, old: &PreparedLayer, reach: &[f64], changed: &mut [bool]) {
         let bounds = |b: &Option<Bounds>| b.map(|b| b.map(|r| r.map(f32::to_bits)));
         let segments = self.nearest.changed_rows(&old.nearest);
