@@ -6,6 +6,8 @@
 //! data (through the handles); every later level is a fixed linear map, so re-evaluating
 //! after an edit costs one pass over the stencils.
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use crate::binary_step;
 use crate::catmull_clark::{self, Level, Stencils};
 use crate::colour::ColourSpace;
@@ -30,7 +32,13 @@ pub struct Refinement {
     /// With interpolated positions: the level at which limit stencils are exact (every
     /// semi-sharp feature has decayed), and those stencils.
     interpolation: Option<(usize, Stencils)>,
+    /// Names this topology: [`Refinement::from_base`] gives each refinement its own, and
+    /// [`Refinement::rebase`] keeps it (see [`Refinement::topology_id`]).
+    topology_id: u64,
 }
+
+/// The next [`Refinement::topology_id`].
+static NEXT_TOPOLOGY_ID: AtomicU64 = AtomicU64::new(0);
 
 /// The data (positions, colours, opacity) of every level of a [`Refinement`].
 #[derive(Clone, Debug, PartialEq)]
@@ -73,6 +81,7 @@ impl Refinement {
             levels: Vec::new(),
             stencils: Vec::new(),
             interpolation: None,
+            topology_id: NEXT_TOPOLOGY_ID.fetch_add(1, Ordering::Relaxed),
         };
         r.extend_to(depth);
         if r.base.interpolate_positions {
@@ -88,6 +97,14 @@ impl Refinement {
             r.interpolation = Some((d, limit));
         }
         r
+    }
+
+    /// An identifier shared only by refinements of the same topology and stencils: this one,
+    /// its clones, and itself after [`Refinement::rebase`]. What was computed on one of its
+    /// levels (a renderer's plans per face, say) fits any refinement with the same identifier,
+    /// whose data may differ.
+    pub fn topology_id(&self) -> u64 {
+        self.topology_id
     }
 
     /// Takes `base` as the base level instead, keeping every level built, if it refines to the

@@ -31,6 +31,7 @@ use crate::catmull_clark::Level;
 use crate::colour::{ColourSpace, Matrix3};
 use crate::refine::{RefinedMesh, Refinement};
 use crate::rules;
+use crate::topology::Topology;
 use crate::validate::VertexData;
 
 use super::layer::{measure_quad, Measure, QuadSamples, Thresholds};
@@ -122,7 +123,7 @@ pub(super) struct Tessellation {
     /// The bounds of the colours in play (those of the base level, whose convex hull holds
     /// the limit surface), when some face is quadratic.
     pub bounds: Option<Bounds>,
-    /// Regular faces whose plans were taken from the [`PlanMemo`].
+    /// Faces whose plans were taken from the [`PlanMemo`].
     pub reused_plans: usize,
 }
 
@@ -378,42 +379,57 @@ struct Plan {
     linear_colour: Option<f64>,
 }
 
-/// The plans of a layer's regular faces at its last preparation, kept by a
-/// [`RenderCache`](super::RenderCache) for the next: a regular face's plan depends only on its
-/// control points, which of its sides lie on the outline, the working space and the options
-/// (the same for every entry of a cache), so a face whose control points are the same bits
-/// plans the same.
-/// After an edit only the faces whose control points it moved are planned again: a point
-/// moved at level 0 changes the base level's points within a few rings of it.
+/// The plans of a layer's faces at its last preparation, kept by a
+/// [`RenderCache`](super::RenderCache) for the next. A face's plan depends only on the
+/// topology and sharpness around it, the points of the faces that share a vertex with it (its
+/// patch's control points, or the neighbourhood its local refinement cuts out), the working
+/// space and the options (the same for every entry of a cache). So where the refinement kept
+/// its topology ([`Refinement::topology_id`]), a face none of whose neighbourhood's points
+/// changed bits plans the same, and keeps its plan (and local refinement) instead. After an
+/// edit only the faces within reach of what it moved are planned again: a point moved at
+/// level 0 changes the base level's points within a few rings of it.
 #[derive(Default)]
 pub(crate) struct PlanMemo {
+    /// The refinement and the level the plans were made on.
+    topology_id: Option<u64>,
     base_level: usize,
     /// The working space the colours are in (a layer whose space changed, and whose points
     /// are black, would have the same bits in another space).
     space: Option<ColourSpace>,
-    faces: Vec<Option<Remembered>>,
+    /// The data of the base level the plans were made from.
+    data: Vec<VertexData>,
+    faces: Vec<KeptPlan>,
     /// The layer's refinement at its last preparation (the topology of its levels and the
     /// stencils between them), which an edit that keeps the topology takes again.
     pub refinement: Option<Refinement>,
 }
 
-/// A regular face's control points, which of its sides lie on the outline, and its plan.
-/// Boxed: the control points are 768 bytes, which every face's result moved around even
-/// where nothing is remembered (a tenth of planning a 90,000-face level went to copies).
-type Remembered = Box<(ControlGrid, [bool; 4], Plan)>;
+/// A face's plan as its last preparation left it (before balancing), shared rather than
+/// copied: with the local refinement an irregular face was planned on, and its root there.
+#[derive(Clone)]
+enum KeptPlan {
+    Regular(Arc<Plan>),
+    Local(Arc<Plan>, Arc<Mutex<LocalPatch>>, usize),
+}
 
-impl PlanMemo {
-    /// The plan kept for face `f` if it was planned from the same control points and sides
-    /// (the caller checks that the memo is of the same base level and space).
-    fn get(&self, f: usize, cp: &ControlGrid, sides: [bool; 4]) -> Option<&Plan> {
-        let (old, old_sides, plan) = &**self.faces.get(f)?.as_ref()?;
-        let same = old
-            .iter()
-            .flatten()
-            .zip(cp.iter().flatten())
-            .all(|(a, b)| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()));
-        (same && *old_sides == sides).then_some(plan)
+/// Which faces must be planned again after the base level's data went from `old` to `new`
+/// (same topology `t`): those sharing a vertex with a face around a point that changed bits.
+fn faces_to_plan_again(t: &Topology, old: &[VertexData], new: &[VertexData]) -> Vec<bool> {
+    let mut again = vec![false; t.face_count()];
+    let changed = |v: &usize| {
+        let (a, b) = (&old[*v], &new[*v]);
+        a.iter().zip(b).any(|(x, y)| x.to_bits() != y.to_bits())
+    };
+    for v in (0..new.len()).filter(changed) {
+        for &g in t.vertex_faces(v) {
+            for &u in t.face_vertices(g as usize) {
+                for &h in t.vertex_faces(u as usize) {
+                    again[h as usize] = true;
+                }
+            }
+        }
     }
+    again
 }
 
 /// What earlier preparations left that a layer's tessellation may take: the local refinements
@@ -439,8 +455,9 @@ pub(super) fn tessellate(
 ) -> Option<Tessellation> {
     let Kept {
         shapes,
-        plans: mut memo,
+        plans: memo,
     } = kept;
+    let topology_id = refinement.topology_id();
     // Faces refine on their own from the base level with bare stencils: it must lie below the
     // rings of the deepest multi-resolution edit.
     while data.levels.len() <= 1 {
@@ -619,41 +636,30 @@ pub(super) fn tessellate(
         }
     };
     // Regular faces first, each on its own, or as the memo of the last preparation has them.
-    // Faces planned afresh are remembered for the next (the others are there already).
-    let old_memo = memo
-        .as_deref()
-        .filter(|m| m.base_level == k0 && m.space == Some(th.space) && m.faces.len() == nf);
-    let planned: Vec<(Option<Plan>, Option<Remembered>, bool)> = each_face(nf, |f| {
+    let old_memo = memo.as_deref().filter(|m| {
+        m.topology_id == Some(topology_id)
+            && m.base_level == k0
+            && m.space == Some(th.space)
+            && m.faces.len() == nf
+            && m.data.len() == d.len()
+    });
+    let again = old_memo.map(|m| faces_to_plan_again(t, &m.data, d));
+    let kept_plan = |f: usize| -> Option<&KeptPlan> {
+        let (m, again) = (old_memo?, again.as_ref()?);
+        (!again[f]).then(|| &m.faces[f])
+    };
+    let planned: Vec<(Option<Arc<Plan>>, bool)> = each_face(nf, |f| {
+        if let Some(KeptPlan::Regular(plan)) = kept_plan(f) {
+            return Some((Some(Arc::clone(plan)), true));
+        }
         let Some(cp) = regular_patch_with(level, d, f, |v| regular[v]) else {
-            return Some((None, None, false));
+            return Some((None, false));
         };
-        let sides = boundary_sides(f);
-        if let Some(plan) = old_memo.and_then(|m| m.get(f, &cp, sides)) {
-            return Some((Some(plan.clone()), None, true));
-        }
         let plan = plan_face(f, &mut Source::Regular(cp))?;
-        let remembered = memo.is_some().then(|| Box::new((cp, sides, plan.clone())));
-        Some((Some(plan), remembered, false))
+        Some((Some(Arc::new(plan)), false))
     })?;
-    let reused_plans = planned.iter().filter(|p| p.2).count();
-    let fresh_memo = old_memo.is_none();
-    if let Some(memo) = memo.as_deref_mut() {
-        if fresh_memo {
-            memo.base_level = k0;
-            memo.space = Some(th.space);
-            memo.faces.clear();
-            memo.faces.resize_with(nf, || None);
-        }
-    }
-    let mut plans: Vec<Option<Plan>> = Vec::with_capacity(nf);
-    for (f, (plan, remembered, kept)) in planned.into_iter().enumerate() {
-        if let Some(memo) = memo.as_deref_mut() {
-            if !kept {
-                memo.faces[f] = remembered;
-            }
-        }
-        plans.push(plan);
-    }
+    let mut reused_plans = planned.iter().filter(|p| p.1).count();
+    let mut plans: Vec<Option<Arc<Plan>>> = planned.into_iter().map(|p| p.0).collect();
     // The others refine locally, grouped by their first corner that is not regular (for
     // most, the extraordinary vertex they surround): a group shares one local refinement.
     let mut irregular: Vec<(usize, usize)> = (0..nf)
@@ -669,7 +675,7 @@ pub(super) fn tessellate(
     // step 2 asks for: cutting out and refining a face's neighbourhood alone again cost
     // Glasses a tenth of a millisecond a face. Faces of one group take turns at its lock;
     // what runs under it stays on its thread (see `patches::LocalShape`).
-    type Planned = Vec<(usize, Plan, Arc<Mutex<LocalPatch>>, usize)>;
+    type Planned = Vec<(usize, Arc<Plan>, Arc<Mutex<LocalPatch>>, usize)>;
     let kept = |src: Source| -> Option<Arc<Mutex<LocalPatch>>> {
         match src {
             Source::Local { patch, .. } => Some(Arc::new(Mutex::new(patch))),
@@ -682,7 +688,7 @@ pub(super) fn tessellate(
             .map(|&(_, f)| {
                 let mut src = Source::new(level, &regular, d, f, shapes)?;
                 let plan = plan_face(f, &mut src)?;
-                Some((f, plan, kept(src)?, 0))
+                Some((f, Arc::new(plan), kept(src)?, 0))
             })
             .collect()
     };
@@ -704,24 +710,43 @@ pub(super) fn tessellate(
             planned
                 .into_iter()
                 .enumerate()
-                .map(|(k, (f, plan))| (f, plan, Arc::clone(&patch), k))
+                .map(|(k, (f, plan))| (f, Arc::new(plan), Arc::clone(&patch), k))
                 .collect(),
         )
     };
-    let planned: Vec<Planned> = groups
+    // A group the edit left alone keeps its plans and local refinement.
+    let kept_group = |group: &[(usize, usize)]| -> Option<Planned> {
+        group
+            .iter()
+            .map(|&(_, f)| match kept_plan(f)? {
+                KeptPlan::Local(plan, patch, root) => {
+                    Some((f, Arc::clone(plan), Arc::clone(patch), *root))
+                }
+                KeptPlan::Regular(_) => None,
+            })
+            .collect()
+    };
+    let planned: Vec<(Planned, bool)> = groups
         .par_iter()
         .map(|&group| {
+            if let Some(kept) = kept_group(group) {
+                return Some((kept, true));
+            }
             // Neighbourhoods that do not form a valid mesh together may do so one by one.
             (group.len() > 1)
                 .then(|| together(group))
                 .flatten()
                 .or_else(|| each_alone(group))
+                .map(|planned| (planned, false))
         })
         .collect::<Option<_>>()?;
     let mut local_of: Vec<Option<(Arc<Mutex<LocalPatch>>, usize)>> = vec![None; nf];
-    for (f, plan, patch, root) in planned.into_iter().flatten() {
-        plans[f] = Some(plan);
-        local_of[f] = Some((patch, root));
+    for (group, kept) in planned {
+        reused_plans += if kept { group.len() } else { 0 };
+        for (f, plan, patch, root) in group {
+            plans[f] = Some(plan);
+            local_of[f] = Some((patch, root));
+        }
     }
     // Face `f`'s grid of `n` cells a side, from its kept local refinement if it has one.
     let regrid = |f: usize, n: usize| -> Option<Grid> {
@@ -733,15 +758,32 @@ pub(super) fn tessellate(
             None => Source::new(level, &regular, d, f, shapes)?.grid(n),
         }
     };
-    let mut plans: Vec<Plan> = plans
+    let mut plans: Vec<Arc<Plan>> = plans
         .into_iter()
         .map(|p| p.expect("every face is planned"))
         .collect();
+    // Remembered as planned: balancing below copies a plan it changes.
+    if let Some(memo) = memo {
+        memo.faces.clear();
+        memo.faces
+            .extend(plans.iter().zip(&local_of).map(|(plan, local)| {
+                let plan = Arc::clone(plan);
+                match local {
+                    Some((patch, root)) => KeptPlan::Local(plan, Arc::clone(patch), *root),
+                    None => KeptPlan::Regular(plan),
+                }
+            }));
+        memo.data.clear();
+        memo.data.extend_from_slice(d);
+        memo.topology_id = Some(topology_id);
+        memo.base_level = k0;
+        memo.space = Some(th.space);
+    }
     // 2. Counts per edge: the finer face's. A face is first refined to at least half of its
     // finest edge (2:1 balance with the faces' own densities: the faces around a deeply
     // refined spot, often a fold near a singular point, follow its shape closely). A coarser
     // face then fans its boundary cells out to the edge's extra samples (step 3).
-    let edge_counts = |plans: &[Plan]| -> Vec<usize> {
+    let edge_counts = |plans: &[Arc<Plan>]| -> Vec<usize> {
         (0..t.edge_count())
             .map(|e| {
                 t.edge_faces(e)
@@ -783,6 +825,7 @@ pub(super) fn tessellate(
                 plan.n.max(finest_edge / 2)
             };
             if n != plan.n {
+                let plan = Arc::make_mut(plan);
                 plan.grid = regrid(f, n)?;
                 // A quadratic face refined further for its neighbours' sake is often fine
                 // enough for linear pieces, which need no grid of twice the count for their
@@ -1477,7 +1520,8 @@ mod tests {
     }
 
     /// A memo of plans gives the same tessellation as planning afresh; after a point moved,
-    /// only the faces around it plan again.
+    /// only the faces around it plan again (regular and irregular); a refinement of another
+    /// topology plans everything again.
     #[test]
     fn remembered_plans_are_taken_for_faces_an_edit_left_alone() {
         let dir = concat!(
@@ -1491,22 +1535,27 @@ mod tests {
         let xf = ToPixels::new(&opts.view, opts.width, opts.height);
         let th = Thresholds::new(&opts, ColourSpace::Lab);
         let shapes = ShapeCache::default();
-        let run = |mesh: &crate::GradientMesh, memo: Option<&mut PlanMemo>| {
-            let (mut refinement, _) = Refinement::new(mesh, 1).unwrap();
-            let mut data = refinement.evaluate();
-            tessellate(
-                &mut refinement,
-                &mut data,
-                &xf,
-                &th,
-                12,
-                (w, h),
-                Kept {
-                    shapes: &shapes,
-                    plans: memo,
+        // As `layer::prepare` does: the memo's refinement takes the new data if it can.
+        let run = |mesh: &crate::GradientMesh, mut memo: Option<&mut PlanMemo>| {
+            let (base, _) = crate::validate::BaseMesh::new(mesh).unwrap();
+            let kept = memo.as_deref_mut().and_then(|m| m.refinement.take());
+            let mut refinement = match kept {
+                Some(mut r) => match r.rebase(base) {
+                    Ok(()) => r,
+                    Err(base) => Refinement::from_base(*base, 1),
                 },
-            )
-            .unwrap()
+                None => Refinement::from_base(base, 1),
+            };
+            let mut data = refinement.evaluate_to(refinement.base(), 1);
+            let kept = Kept {
+                shapes: &shapes,
+                plans: memo.as_deref_mut(),
+            };
+            let tess = tessellate(&mut refinement, &mut data, &xf, &th, 12, (w, h), kept).unwrap();
+            if let Some(memo) = memo {
+                memo.refinement = Some(refinement);
+            }
+            tess
         };
         let same = |a: &Tessellation, b: &Tessellation| {
             assert_eq!(a.triangles.len(), b.triangles.len());
@@ -1518,31 +1567,49 @@ mod tests {
         let first = run(&doc.layers[0], Some(&mut memo));
         assert_eq!(first.reused_plans, 0);
         same(&first, &run(&doc.layers[0], None));
-        // Unchanged: every regular face keeps its plan.
+        // Unchanged: every face keeps its plan.
         let again = run(&doc.layers[0], Some(&mut memo));
-        let regular = memo.faces.iter().flatten().count();
-        assert!(regular > 1000, "{regular} regular faces");
-        assert_eq!(again.reused_plans, regular);
+        let faces = memo.faces.len();
+        let local = |m: &PlanMemo| {
+            let local = m.faces.iter().filter(|p| matches!(p, KeptPlan::Local(..)));
+            local.count()
+        };
+        assert!(faces > 1000 && local(&memo) > 100, "{faces} faces");
+        assert_eq!(again.reused_plans, faces);
         same(&again, &first);
         // A point moved: the faces within its reach plan again, and the result is a fresh one's.
         doc.layers[0].points[40].position.x += 2.0;
         let moved = run(&doc.layers[0], Some(&mut memo));
-        assert!(
-            moved.reused_plans > regular / 2,
-            "{} of {regular}",
-            moved.reused_plans
-        );
-        assert!(
-            moved.reused_plans < regular,
-            "{} of {regular}",
-            moved.reused_plans
-        );
+        let reused = moved.reused_plans;
+        assert!(reused > faces / 2 && reused < faces, "{reused} of {faces}");
         same(&moved, &run(&doc.layers[0], None));
+        // Points moved next to extraordinary vertices: irregular faces plan again too.
+        let before = memo.faces.clone();
+        for p in doc.layers[0].points.iter_mut().step_by(7) {
+            p.position.y += 1.0;
+        }
+        let moved = run(&doc.layers[0], Some(&mut memo));
+        same(&moved, &run(&doc.layers[0], None));
+        let replanned = |local: bool| {
+            let pairs = before.iter().zip(&memo.faces);
+            pairs
+                .filter(|(a, b)| match (a, b) {
+                    (KeptPlan::Regular(a), KeptPlan::Regular(b)) => !local && !Arc::ptr_eq(a, b),
+                    (KeptPlan::Local(a, ..), KeptPlan::Local(b, ..)) => local && !Arc::ptr_eq(a, b),
+                    _ => false,
+                })
+                .count()
+        };
+        assert!(replanned(true) > 0 && replanned(false) > 0);
+        assert!(moved.reused_plans > 0 && moved.reused_plans < faces);
+        // Another refinement of the same mesh: nothing is kept.
+        memo.refinement = None;
+        assert_eq!(run(&doc.layers[0], Some(&mut memo)).reused_plans, 0);
         // The same bits in another working space are other colours: nothing is kept (capped
         // at level 4: read as Oklab, these colours would take deep grids).
         let th = Thresholds::new(&opts, ColourSpace::Oklab);
-        let (mut refinement, _) = Refinement::new(&doc.layers[0], 1).unwrap();
-        let mut data = refinement.evaluate();
+        let mut refinement = memo.refinement.take().unwrap();
+        let mut data = refinement.evaluate_to(refinement.base(), 1);
         let kept = Kept {
             shapes: &shapes,
             plans: Some(&mut memo),
