@@ -399,9 +399,49 @@ pub(crate) struct PlanMemo {
     /// The data of the base level the plans were made from.
     data: Vec<VertexData>,
     faces: Vec<KeptPlan>,
+    /// What the plans drew: each face's count after balancing, the colour bounds quadratic
+    /// triangles were clamped to, and the triangles of each block of [`FACES_PER_BLOCK`]
+    /// faces (empty until the triangles of the plans above are built).
+    drawn: Option<DrawnFaces>,
     /// The layer's refinement at its last preparation (the topology of its levels and the
     /// stencils between them), which an edit that keeps the topology takes again.
     pub refinement: Option<Refinement>,
+}
+
+/// See [`PlanMemo::drawn`].
+struct DrawnFaces {
+    counts: Vec<usize>,
+    bounds: Option<Bounds>,
+    blocks: Vec<Arc<Vec<Triangle>>>,
+}
+
+/// Faces whose triangles are built (and kept) together, in face order: a fixed number, so
+/// that the blocks of two preparations of a layer match.
+const FACES_PER_BLOCK: usize = 64;
+
+/// Which blocks of `per_block` faces (in face order) must build their triangles again: those
+/// with a face that shares a vertex with a face that did not keep its plan (`kept`), or whose
+/// count after balancing changed (from `last` to `now`). The triangles of a face depend only
+/// on the plans of the faces sharing a vertex with it (their samples along its sides and at
+/// its corners, and the counts of its edges).
+fn blocks_to_build(
+    t: &Topology,
+    kept: &[bool],
+    now: &[usize],
+    last: &[usize],
+    per_block: usize,
+) -> Vec<bool> {
+    let mut build = vec![false; t.face_count().div_ceil(per_block)];
+    for g in 0..t.face_count() {
+        if !kept[g] || now[g] != last[g] {
+            for &u in t.face_vertices(g) {
+                for &h in t.vertex_faces(u as usize) {
+                    build[h as usize / per_block] = true;
+                }
+            }
+        }
+    }
+    build
 }
 
 /// A face's plan as its last preparation left it (before balancing), shared rather than
@@ -455,7 +495,7 @@ pub(super) fn tessellate(
 ) -> Option<Tessellation> {
     let Kept {
         shapes,
-        plans: memo,
+        plans: mut memo,
     } = kept;
     let topology_id = refinement.topology_id();
     // Faces refine on their own from the base level with bare stencils: it must lie below the
@@ -658,7 +698,8 @@ pub(super) fn tessellate(
         let plan = plan_face(f, &mut Source::Regular(cp))?;
         Some((Some(Arc::new(plan)), false))
     })?;
-    let mut reused_plans = planned.iter().filter(|p| p.1).count();
+    // Which faces kept their plans.
+    let mut kept_faces: Vec<bool> = planned.iter().map(|p| p.1).collect();
     let mut plans: Vec<Option<Arc<Plan>>> = planned.into_iter().map(|p| p.0).collect();
     // The others refine locally, grouped by their first corner that is not regular (for
     // most, the extraordinary vertex they surround): a group shares one local refinement.
@@ -742,12 +783,13 @@ pub(super) fn tessellate(
         .collect::<Option<_>>()?;
     let mut local_of: Vec<Option<(Arc<Mutex<LocalPatch>>, usize)>> = vec![None; nf];
     for (group, kept) in planned {
-        reused_plans += if kept { group.len() } else { 0 };
         for (f, plan, patch, root) in group {
             plans[f] = Some(plan);
             local_of[f] = Some((patch, root));
+            kept_faces[f] = kept;
         }
     }
+    let reused_plans = kept_faces.iter().filter(|&&k| k).count();
     // Face `f`'s grid of `n` cells a side, from its kept local refinement if it has one.
     let regrid = |f: usize, n: usize| -> Option<Grid> {
         match &local_of[f] {
@@ -762,8 +804,11 @@ pub(super) fn tessellate(
         .into_iter()
         .map(|p| p.expect("every face is planned"))
         .collect();
-    // Remembered as planned: balancing below copies a plan it changes.
-    if let Some(memo) = memo {
+    // Remembered as planned: balancing below copies a plan it changes. What the last plans
+    // drew is taken out (it fits these plans only where they were kept).
+    let mut last_drawn = None;
+    if let Some(memo) = memo.as_deref_mut() {
+        last_drawn = memo.drawn.take().filter(|_| again.is_some());
         memo.faces.clear();
         memo.faces
             .extend(plans.iter().zip(&local_of).map(|(plan, local)| {
@@ -1177,18 +1222,46 @@ pub(super) fn tessellate(
             }
         }
     };
-    // Appended to one growing list per rayon job (collect keeps their order): a list per face,
-    // sized for all its cells' triangles, cost a fresh allocation per face, and most of a
-    // dense layer's triangles are culled.
-    let triangles = TriangleList::from_chunks(
-        (0..nf)
-            .into_par_iter()
-            .fold(Vec::new, |mut out, f| {
-                face_triangles(&mut out, f);
-                out
-            })
-            .collect(),
-    );
+    // A face draws as last time if every face sharing a vertex with it kept its plan and its
+    // count (its grid and nodes then come out the same), under the same colour bounds: the
+    // blocks of faces that all do are taken as they were.
+    let blocks = nf.div_ceil(FACES_PER_BLOCK);
+    let same_bounds = |a: &Option<Bounds>| {
+        let bits = |b: &Option<Bounds>| b.map(|b| b.map(|row| row.map(f32::to_bits)));
+        bits(a) == bits(&bounds)
+    };
+    let last_blocks = last_drawn
+        .filter(|last| {
+            last.counts.len() == nf && last.blocks.len() == blocks && same_bounds(&last.bounds)
+        })
+        .map(|last| {
+            let counts: Vec<usize> = plans.iter().map(|p| p.n).collect();
+            let build = blocks_to_build(t, &kept_faces, &counts, &last.counts, FACES_PER_BLOCK);
+            (last.blocks, build)
+        });
+    // A list per block (a list per face, sized for all its cells' triangles, cost a fresh
+    // allocation per face, and most of a dense layer's triangles are culled).
+    let triangle_blocks: Vec<Arc<Vec<Triangle>>> = (0..blocks)
+        .into_par_iter()
+        .map(|b| match &last_blocks {
+            Some((last, build)) if !build[b] => Arc::clone(&last[b]),
+            _ => {
+                let mut out = Vec::new();
+                for f in b * FACES_PER_BLOCK..((b + 1) * FACES_PER_BLOCK).min(nf) {
+                    face_triangles(&mut out, f);
+                }
+                Arc::new(out)
+            }
+        })
+        .collect();
+    if let Some(memo) = memo {
+        memo.drawn = Some(DrawnFaces {
+            counts: plans.iter().map(|p| p.n).collect(),
+            bounds,
+            blocks: triangle_blocks.clone(),
+        });
+    }
+    let triangles = TriangleList::from_shared(triangle_blocks);
 
     // The boundary of the tessellation, loop by loop.
     let mut segments = Vec::new();
@@ -1602,6 +1675,13 @@ mod tests {
         };
         assert!(replanned(true) > 0 && replanned(false) > 0);
         assert!(moved.reused_plans > 0 && moved.reused_plans < faces);
+        // A colour far from its neighbours', at a point moved far: the faces around it take
+        // other grids, and the triangles kept around them still fit.
+        doc.layers[0].points[60].colour = [100.0, 90.0, -90.0];
+        doc.layers[0].points[60].colour_text = None;
+        doc.layers[0].points[60].position.x += 30.0;
+        let moved = run(&doc.layers[0], Some(&mut memo));
+        same(&moved, &run(&doc.layers[0], None));
         // Another refinement of the same mesh: nothing is kept.
         memo.refinement = None;
         assert_eq!(run(&doc.layers[0], Some(&mut memo)).reused_plans, 0);
@@ -1616,6 +1696,29 @@ mod tests {
         };
         let other = tessellate(&mut refinement, &mut data, &xf, &th, 4, (w, h), kept).unwrap();
         assert_eq!(other.reused_plans, 0);
+    }
+
+    /// A block builds its triangles again when a face sharing a vertex with one of its faces
+    /// planned again or changed its count, and not otherwise.
+    #[test]
+    fn blocks_build_again_around_faces_whose_plans_or_counts_changed() {
+        // A strip of three quads: the first and the last share no vertex.
+        let t = Topology::build(
+            8,
+            vec![0, 4, 8, 12],
+            vec![0, 1, 5, 4, 1, 2, 6, 5, 2, 3, 7, 6],
+            |_, _| false,
+        )
+        .unwrap();
+        let build = |kept: [bool; 3], now: [usize; 3], per_block: usize| {
+            blocks_to_build(&t, &kept, &now, &[2, 2, 2], per_block)
+        };
+        assert_eq!(build([true; 3], [2; 3], 1), [false; 3]);
+        assert_eq!(build([true; 3], [2, 4, 2], 1), [true; 3]);
+        assert_eq!(build([true; 3], [4, 2, 2], 1), [true, true, false]);
+        assert_eq!(build([true, true, false], [2; 3], 1), [false, true, true]);
+        assert_eq!(build([true; 3], [4, 2, 2], 2), [true, false]);
+        assert_eq!(build([true; 3], [2, 2, 1], 2), [true, true]);
     }
 
     /// Pixel coverage counts of a tessellation.

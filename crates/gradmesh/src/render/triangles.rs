@@ -7,6 +7,8 @@
 //! perturbation of the sample point and so also settles centres on shared vertices). Interior
 //! edges have no gaps and no double coverage.
 
+use std::sync::Arc;
+
 use super::each4;
 
 /// Sub-pixel steps per pixel.
@@ -134,19 +136,25 @@ pub(crate) const UNBOUNDED: Bounds = [[f32::NEG_INFINITY; 4], [f32::INFINITY; 4]
 /// Rows are kept within this magnitude: images are at most 2^16 rows tall.
 const ROW_CLAMP: i64 = 1 << 30;
 
-/// Triangles in drawing order, kept in the chunks they were built in (one per face on the
-/// fast path): concatenating them would write every triangle to fresh memory a second time,
-/// and first touches of pages cost more than building the triangles.
+/// Triangles in drawing order, kept in the chunks they were built in (one per block of faces
+/// on the fast path): concatenating them would write every triangle to fresh memory a second
+/// time, and first touches of pages cost more than building the triangles. Chunks are shared:
+/// a layer prepared again after an edit takes the blocks the edit left alone.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct TriangleList {
-    chunks: Vec<Vec<Triangle>>,
+    chunks: Vec<Arc<Vec<Triangle>>>,
     /// The index of each chunk's first triangle, and the total at the end.
     starts: Vec<usize>,
 }
 
 impl TriangleList {
     pub fn from_chunks(chunks: Vec<Vec<Triangle>>) -> TriangleList {
-        let chunks: Vec<Vec<Triangle>> = chunks.into_iter().filter(|c| !c.is_empty()).collect();
+        TriangleList::from_shared(chunks.into_iter().map(Arc::new).collect())
+    }
+
+    /// The list of the triangles of `chunks`, in order (without copying them).
+    pub fn from_shared(chunks: Vec<Arc<Vec<Triangle>>>) -> TriangleList {
+        let chunks: Vec<_> = chunks.into_iter().filter(|c| !c.is_empty()).collect();
         let mut starts = Vec::with_capacity(chunks.len() + 1);
         let mut total = 0;
         starts.push(0);
@@ -163,7 +171,7 @@ impl TriangleList {
 
     /// Every triangle, in order.
     pub fn iter(&self) -> impl Iterator<Item = &Triangle> {
-        self.chunks.iter().flatten()
+        self.chunks.iter().flat_map(|c| c.iter())
     }
 
     /// A reader for increasing indices (a band's bin), each found in amortised constant time.
