@@ -406,13 +406,15 @@ pub fn render_document_into<P: OutputPixel>(
 /// drawing, not for the other layers. The cache holds a copy of each mesh it compares against,
 /// and the prepared triangles and outlines (a few megabytes for a dense layer at 1024 pixels).
 /// It also keeps the structure of the local refinements around extraordinary vertices and
-/// creases, which depends on the topology alone, and the plan of each regular face of a
-/// layer (its grid density and samples), which depends on its sixteen control points alone:
-/// a layer whose points or colours moved reuses the first, and plans again only the faces
-/// within reach of what moved ([`LayerInfo::reused_faces`]).
+/// creases, which depends on the topology alone. A layer whose points or colours moved
+/// reuses those.
 ///
 /// An edited layer whose topology (faces, edge kinds and sharpness, rules) stayed also keeps
-/// the topology of its refinement levels and their stencils ([`crate::Refinement::rebase`]).
+/// the topology of its refinement levels and their stencils ([`crate::Refinement::rebase`]),
+/// the plan of each face (its grid density and samples, which depend on the points of the
+/// faces around it alone), and the triangles of each block of faces: it plans again only
+/// the faces within reach of what moved ([`LayerInfo::reused_faces`]), and builds again only
+/// the blocks of triangles next to them.
 ///
 /// It keeps the last image drawn, too: a band of rows where no layer's triangles, outline or
 /// outline colours changed is copied from it instead of drawn ([`RenderInfo::drawn_bands`]).
