@@ -5,7 +5,7 @@
 //! paints the same 9 patches as Coons patches whose edges are the cubic Béziers through the
 //! control points with their handles (as Illustrator's mesh).
 //!
-//! Run: `apt-get install libcairo2-dev` then
+//! Run: `apt-get update && apt-get install libcairo2-dev` then
 //! `cargo bench -p gradmesh --features cairo-bench --bench vs_cairo`.
 
 #![allow(missing_docs)] // criterion_group! generates undocumented items.

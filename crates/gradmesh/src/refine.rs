@@ -128,6 +128,19 @@ impl Refinement {
         Ok(())
     }
 
+    /// `kept` with `base` as its base level if it refines to the same topology and stencils
+    /// (see [`Refinement::rebase`]), else a new refinement of `base` to level `depth`: what an
+    /// editor calls after an edit, to build levels only when the edit changed the topology.
+    pub fn rebased_or_new(kept: Option<Refinement>, base: BaseMesh, depth: usize) -> Refinement {
+        match kept {
+            Some(mut r) => match r.rebase(base) {
+                Ok(()) => r,
+                Err(base) => Refinement::from_base(*base, depth),
+            },
+            None => Refinement::from_base(base, depth),
+        }
+    }
+
     /// Refines further so that level `depth` exists.
     pub fn extend_to(&mut self, depth: usize) {
         if depth >= 1 && self.levels.is_empty() {
@@ -446,5 +459,34 @@ mod tests {
         more.add_face(vec![10, 11, 12]);
         let (base, _) = BaseMesh::new(&more).unwrap();
         assert!(kept.rebase(base).is_err());
+    }
+
+    /// What an editor keeps: the same refinement (its identifier and levels) after a data
+    /// edit, a new one to the asked depth after a change of topology or with nothing kept.
+    #[test]
+    fn rebased_or_new_keeps_the_refinement_only_for_the_same_topology() {
+        let mesh = grid();
+        let (kept, _) = Refinement::new(&mesh, 3).unwrap();
+        let id = kept.topology_id();
+        let mut edited = mesh.clone();
+        edited.points[5].colour[0] += 4.0;
+        let (base, _) = BaseMesh::new(&edited).unwrap();
+        let again = Refinement::rebased_or_new(Some(kept), base, 1);
+        assert_eq!((again.topology_id(), again.depth()), (id, 3));
+        assert_eq!(
+            again.evaluate(),
+            Refinement::new(&edited, 3).unwrap().0.evaluate()
+        );
+
+        let mut creased = mesh.clone();
+        creased.set_edge(5, 6, EdgeKind::Crease, Some(2.0));
+        let (base, _) = BaseMesh::new(&creased).unwrap();
+        let new = Refinement::rebased_or_new(Some(again), base, 1);
+        assert_ne!(new.topology_id(), id);
+        assert_eq!(new.depth(), 1);
+        let (base, _) = BaseMesh::new(&mesh).unwrap();
+        let none = Refinement::rebased_or_new(None, base, 2);
+        assert_ne!(none.topology_id(), new.topology_id());
+        assert_eq!(none.depth(), 2);
     }
 }

@@ -1614,13 +1614,7 @@ mod tests {
         let run = |mesh: &crate::GradientMesh, mut memo: Option<&mut PlanMemo>| {
             let (base, _) = crate::validate::BaseMesh::new(mesh).unwrap();
             let kept = memo.as_deref_mut().and_then(|m| m.refinement.take());
-            let mut refinement = match kept {
-                Some(mut r) => match r.rebase(base) {
-                    Ok(()) => r,
-                    Err(base) => Refinement::from_base(*base, 1),
-                },
-                None => Refinement::from_base(base, 1),
-            };
+            let mut refinement = Refinement::rebased_or_new(kept, base, 1);
             let mut data = refinement.evaluate_to(refinement.base(), 1);
             let kept = Kept {
                 shapes: &shapes,

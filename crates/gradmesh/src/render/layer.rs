@@ -708,13 +708,7 @@ pub(crate) fn prepare(
     // whose topology stayed takes the levels its last preparation built.
     let (base, warnings) = BaseMesh::new(&mesh).map_err(|e| e.in_layer(index))?;
     let kept = memo.as_deref_mut().and_then(|m| m.refinement.take());
-    let mut refinement = match kept {
-        Some(mut r) => match r.rebase(base) {
-            Ok(()) => r,
-            Err(base) => Refinement::from_base(*base, 1),
-        },
-        None => Refinement::from_base(base, 1),
-    };
+    let mut refinement = Refinement::rebased_or_new(kept, base, 1);
     // The edits' colours stay in the space they were written in.
     refinement.set_edit_colour_space(original_space);
     let warnings = warnings
