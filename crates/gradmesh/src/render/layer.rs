@@ -141,10 +141,12 @@ impl PreparedLayer {
                 .any(|&[lo, hi]| lo <= bottom + margin && hi >= top - margin);
             let (a, b) = (self.triangle_bins.get(band), old.triangle_bins.get(band));
             let (mut x, mut y) = (self.triangles.cursor(), old.triangles.cursor());
+            // A triangle of a block both preparations share is one object: no need to read it.
             let same_triangles = a.len() == b.len()
-                && a.iter()
-                    .zip(b)
-                    .all(|(&i, &j)| x.get(i as usize).same_bits(y.get(j as usize)));
+                && a.iter().zip(b).all(|(&i, &j)| {
+                    let (p, q) = (x.get(i as usize), y.get(j as usize));
+                    std::ptr::eq(p, q) || p.same_bits(q)
+                });
             let (a, b) = (self.line_bins.get(band), old.line_bins.get(band));
             let same_lines = a.len() == b.len()
                 && a.iter()
