@@ -1232,13 +1232,15 @@ pub(super) fn tessellate(
         let bits = |b: &Option<Bounds>| b.map(|b| b.map(|row| row.map(f32::to_bits)));
         bits(a) == bits(&bounds)
     };
+    // Each face's count after balancing, for a memo only.
+    let counts: Option<Vec<usize>> = memo.is_some().then(|| plans.iter().map(|p| p.n).collect());
     let last_blocks = last_drawn
-        .filter(|last| {
+        .zip(counts.as_ref())
+        .filter(|(last, _)| {
             last.counts.len() == nf && last.blocks.len() == blocks && same_bounds(&last.bounds)
         })
-        .map(|last| {
-            let counts: Vec<usize> = plans.iter().map(|p| p.n).collect();
-            let build = blocks_to_build(t, &kept_faces, &counts, &last.counts, FACES_PER_BLOCK);
+        .map(|(last, counts)| {
+            let build = blocks_to_build(t, &kept_faces, counts, &last.counts, FACES_PER_BLOCK);
             (last.blocks, build)
         });
     // A list per block (a list per face, sized for all its cells' triangles, cost a fresh
@@ -1256,9 +1258,9 @@ pub(super) fn tessellate(
             }
         })
         .collect();
-    if let Some(memo) = memo {
+    if let (Some(memo), Some(counts)) = (memo, counts) {
         memo.drawn = Some(DrawnFaces {
-            counts: plans.iter().map(|p| p.n).collect(),
+            counts,
             bounds,
             blocks: triangle_blocks.clone(),
         });
