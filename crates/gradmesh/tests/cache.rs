@@ -3,11 +3,12 @@
 //! prepared again, each planning again only the faces an edit touched.
 
 use gradmesh::formats::read_path;
+use gradmesh::render::BlendSpace;
 use gradmesh::render::{
     document_bounds, render_document_into, render_document_into_cached, RenderCache, RenderOptions,
     View,
 };
-use gradmesh::Document;
+use gradmesh::{ColourSpace, Document};
 
 /// The six layers of the authors' Tucan, bottom to top.
 fn tucan() -> Document {
@@ -129,17 +130,34 @@ fn cached_renders_equal_fresh_ones_and_prepare_only_what_changed() {
 
 /// Renders with the cache into `P` pixels and from scratch, asserts they agree, and returns
 /// how many bands the cached render drew.
-fn drawn_bands<P: gradmesh::render::OutputPixel + Default + PartialEq>(
+fn drawn_bands<P: gradmesh::render::OutputPixel + Default + PartialEq + std::fmt::Debug>(
     doc: &Document,
     opts: &RenderOptions,
     cache: &mut RenderCache,
 ) -> usize {
+    drawn::<P>(doc, opts, cache).0
+}
+
+/// [`drawn_bands`], and how many pixels the cached render drew.
+fn drawn<P: gradmesh::render::OutputPixel + Default + PartialEq + std::fmt::Debug>(
+    doc: &Document,
+    opts: &RenderOptions,
+    cache: &mut RenderCache,
+) -> (usize, u64) {
     let n = 4 * (opts.width * opts.height) as usize;
     let (mut cached, mut fresh) = (vec![P::default(); n], vec![P::default(); n]);
     let info = render_document_into_cached(doc, opts, cache, &mut cached).unwrap();
     render_document_into(doc, opts, &mut fresh).unwrap();
     assert!(cached == fresh, "cached and fresh renders differ");
-    info.drawn_bands
+    // Bit for bit: `==` takes -0 for 0.
+    let bits = |v: &[P]| format!("{v:?}");
+    if std::any::TypeId::of::<P>() == std::any::TypeId::of::<f32>() {
+        assert!(
+            bits(&cached) == bits(&fresh),
+            "cached and fresh renders differ"
+        );
+    }
+    (info.drawn_bands, info.drawn_pixels)
 }
 
 #[test]
@@ -183,4 +201,73 @@ fn edits_draw_again_only_the_bands_they_change() {
     opts.dither = !opts.dither;
     assert_eq!(drawn_bands::<u8>(&doc, &opts, &mut cache), all);
     assert_eq!(drawn_bands::<u8>(&doc, &opts, &mut cache), 0);
+}
+
+/// Within the bands an edit changes, only the columns it can change are drawn again, and the
+/// pixels are those of a render from scratch: in every kind of output (dithered, linear
+/// blending, on a background, 16-bit, float) and working space (Lab's runs, an sRGB layer's
+/// own loop, the gamut search of colours out of range).
+#[test]
+fn edits_draw_again_only_the_columns_they_change() {
+    let mut doc = tucan();
+    // Layer 4 in sRGB with every colour in range, layer 1 in Oklab (some of its colours are
+    // outside sRGB).
+    let mut convert = |l: usize, space: ColourSpace, clamp: bool| {
+        let layer = &mut doc.layers[l];
+        let colours = layer.points.iter_mut().map(|p| &mut p.colour);
+        for c in colours.chain(layer.wedges.iter_mut().map(|w| &mut w.colour)) {
+            *c = layer.colour_space.convert(space, *c);
+            if clamp {
+                *c = c.map(|v| v.clamp(0.0, 1.0));
+            }
+        }
+        layer.colour_space = space;
+    };
+    convert(4, ColourSpace::Srgb, true);
+    convert(1, ColourSpace::Oklab, false);
+    let base = options(&doc, 300);
+    let band_pixels = |bands: usize| (bands * 16 * base.width as usize) as u64;
+    let mut kinds = Vec::new();
+    for (dither, blend, background) in [
+        (true, BlendSpace::Srgb, None),
+        (false, BlendSpace::Linear, Some([0.9, 0.8, 0.7, 0.6])),
+    ] {
+        let mut opts = base.clone();
+        (opts.dither, opts.blend, opts.background) = (dither, blend, background);
+        kinds.push(opts);
+    }
+    for (k, opts) in kinds.iter().enumerate() {
+        let mut doc = doc.clone();
+        // The second kind in 16-bit and float pixels, each with its own cache.
+        let mut caches = [RenderCache::new(), RenderCache::new()];
+        let mut draw = |doc: &Document| match k {
+            0 => drawn::<u8>(doc, opts, &mut caches[0]),
+            _ => {
+                let (bands, pixels) = drawn::<u16>(doc, opts, &mut caches[0]);
+                assert_eq!(drawn::<f32>(doc, opts, &mut caches[1]), (bands, pixels));
+                (bands, pixels)
+            }
+        };
+        draw(&doc);
+        let (mut fewer, mut edits) = (0, 0);
+        for l in [1, 3, 4, 5] {
+            let count = doc.layers[l].points.len();
+            for i in [0, count / 2, count - 1] {
+                for step in [0.6, -0.6] {
+                    let p = &mut doc.layers[l].points[i];
+                    p.position.x += step;
+                    p.position.y -= 0.5 * step;
+                    let (bands, pixels) = draw(&doc);
+                    assert!(pixels <= band_pixels(bands));
+                    assert!(bands == 0 || pixels > 0);
+                    fewer += usize::from(pixels < band_pixels(bands) / 2);
+                    edits += 1;
+                }
+            }
+        }
+        assert!(
+            3 * fewer >= 2 * edits,
+            "only {fewer} of {edits} edits drew under half their bands' columns"
+        );
+    }
 }

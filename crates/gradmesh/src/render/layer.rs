@@ -108,51 +108,140 @@ pub(crate) struct PreparedLayer {
     pub colours_in_unit_range: bool,
 }
 
+/// Columns `[start, end)` of a band that may draw differently: empty when `start >= end`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Columns {
+    pub start: usize,
+    pub end: usize,
+}
+
+impl Columns {
+    /// No column.
+    pub const NONE: Columns = Columns {
+        start: usize::MAX,
+        end: 0,
+    };
+
+    /// Every column of a `width`-pixel image.
+    pub fn all(width: usize) -> Columns {
+        Columns {
+            start: 0,
+            end: width,
+        }
+    }
+
+    pub fn is_empty(self) -> bool {
+        self.start >= self.end
+    }
+
+    /// How many columns.
+    pub fn len(self) -> usize {
+        self.end.saturating_sub(self.start)
+    }
+
+    /// Widens these columns to hold `start..end` too (nothing if that is empty).
+    pub fn include(&mut self, start: usize, end: usize) {
+        if start < end {
+            self.start = self.start.min(start);
+            self.end = self.end.max(end);
+        }
+    }
+}
+
 impl PreparedLayer {
-    /// Marks in `changed` (a flag per band) the bands where this layer may draw differently
-    /// from `old`, its last preparation: those whose triangles or outline lines differ in any
-    /// bit, and those within `reach[band]` of a boundary segment that changed (the farthest
-    /// its outline pixels there took their colour from when last drawn); every band when
-    /// something the whole layer's drawing reads changed (its colour space, columns or colour
-    /// bounds, or the number of boundary segments).
-    pub fn mark_changed_bands(&self, old: &PreparedLayer, reach: &[f64], changed: &mut [bool]) {
+    /// Widens, in `dirty` (columns per band of a `width`-pixel image), the columns where this
+    /// layer may draw differently from `old`, its last preparation:
+    /// - where a triangle of either lies that the other does not hold, bit for bit, at the
+    ///   same place (chunk and offset: triangles are drawn in the order of their places, so a
+    ///   pixel no such triangle covers shows the same triangle in both);
+    /// - from the leftmost outline line that differs in any bit to the layer's right end
+    ///   (coverage is a prefix sum along the row: to the left of a change it is the same sum,
+    ///   to the right only the same up to rounding);
+    /// - within `reach[band]` of a boundary segment that changed (the farthest its outline
+    ///   pixels there took their colour from when last drawn);
+    ///
+    /// and every column of every band when something the whole layer's drawing reads changed
+    /// (its colour space, columns or colour bounds, or the number of boundary segments).
+    pub fn mark_changed_columns(
+        &self,
+        old: &PreparedLayer,
+        reach: &[f64],
+        width: usize,
+        dirty: &mut [Columns],
+    ) {
+        let all = Columns::all(width);
         let bounds = |b: &Option<Bounds>| b.map(|b| b.map(|r| r.map(f32::to_bits)));
-        let segments = self.nearest.changed_rows(&old.nearest);
+        let segments = self.nearest.changed_boxes(&old.nearest);
         let Some(segments) = segments.filter(|_| {
             self.space == old.space
                 && self.columns == old.columns
                 && bounds(&self.bounds) == bounds(&old.bounds)
                 && self.colours_in_unit_range == old.colours_in_unit_range
         }) else {
-            changed.fill(true);
+            dirty.fill(all);
             return;
         };
+        let column = |x: f64| x.clamp(0.0, width as f64) as usize;
         let line = |l: &Line| [l.p0, l.p1].map(|p| p.map(f64::to_bits));
-        for (band, changed) in changed.iter_mut().enumerate() {
-            if *changed {
+        for (band, dirty) in dirty.iter_mut().enumerate() {
+            if *dirty == all {
                 continue;
             }
             // A changed segment farther from every pixel centre of the band than the answers
             // its outline pixels took (plus a pixel, for rounding) changes none of them.
             let (top, bottom) = ((band * BAND) as f64 + 0.5, ((band + 1) * BAND) as f64 - 0.5);
             let margin = reach[band] + 1.0;
-            let near = segments
-                .iter()
-                .any(|&[lo, hi]| lo <= bottom + margin && hi >= top - margin);
-            let (a, b) = (self.triangle_bins.get(band), old.triangle_bins.get(band));
-            let (mut x, mut y) = (self.triangles.cursor(), old.triangles.cursor());
-            // A triangle of a block both preparations share is one object: no need to read it.
-            let same_triangles = a.len() == b.len()
-                && a.iter().zip(b).all(|(&i, &j)| {
-                    let (p, q) = (x.get(i as usize), y.get(j as usize));
-                    std::ptr::eq(p, q) || p.same_bits(q)
-                });
+            for &[[x0, x1], [y0, y1]] in &segments {
+                if y0 <= bottom + margin && y1 >= top - margin {
+                    let (a, b) = (x0 - margin, x1 + margin);
+                    dirty.include(column(a.floor()), column(b.ceil() + 1.0));
+                }
+            }
+
+            for (layer, other) in [(self, old), (old, self)] {
+                let mut cursor = layer.triangles.cursor();
+                for &i in layer.triangle_bins.get(band) {
+                    let (place, t) = cursor.get_placed(i as usize);
+                    // Blocks of faces kept from the last preparation hold the same objects.
+                    let same = other
+                        .triangles
+                        .at(place)
+                        .is_some_and(|u| std::ptr::eq(t, u) || t.same_bits(u));
+                    if !same {
+                        let (a, b) = t.columns(width);
+                        dirty.include(a, b);
+                    }
+                }
+            }
+
+            // The lines in neither the common start nor the common end of the two bins.
             let (a, b) = (self.line_bins.get(band), old.line_bins.get(band));
-            let same_lines = a.len() == b.len()
-                && a.iter()
-                    .zip(b)
-                    .all(|(&i, &j)| line(&self.lines[i as usize]) == line(&old.lines[j as usize]));
-            *changed = near || !(same_triangles && same_lines);
+            let same = |(&i, &j): (&u32, &u32)| {
+                line(&self.lines[i as usize]) == line(&old.lines[j as usize])
+            };
+            let prefix = a.iter().zip(b).take_while(|&p| same(p)).count();
+            let rest = a.len().min(b.len()) - prefix;
+            let suffix = a
+                .iter()
+                .rev()
+                .zip(b.iter().rev())
+                .take(rest)
+                .take_while(|&p| same(p))
+                .count();
+            let middle = |bin: &[u32], layer: &PreparedLayer| {
+                bin[prefix..bin.len() - suffix]
+                    .iter()
+                    .map(|&i| {
+                        let l = &layer.lines[i as usize];
+                        l.p0[0].min(l.p1[0])
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let left = middle(a, self).min(middle(b, old));
+            if left < f64::INFINITY {
+                // The cells a line changes start at the one holding its left end.
+                dirty.include(column(left.floor() - 1.0), self.columns.1.min(width));
+            }
         }
     }
 }
@@ -901,32 +990,43 @@ mod tests {
         }
     }
 
-    /// A changed boundary segment marks the bands whose outline pixels took colours from
-    /// within its reach, and no other.
+    /// A changed boundary segment marks the columns of the bands whose outline pixels took
+    /// colours from within its reach, and no other.
     #[test]
-    fn changed_segments_mark_the_bands_within_reach() {
+    fn changed_segments_mark_the_columns_within_reach() {
         let bands = 8;
+        let width = 40;
         let (old, new) = (segments_only(bands, None), segments_only(bands, Some(9)));
         let changed = |reach: f64| {
-            let mut changed = vec![false; bands];
-            new.mark_changed_bands(&old, &vec![reach; bands], &mut changed);
-            changed
+            let mut dirty = vec![Columns::NONE; bands];
+            new.mark_changed_columns(&old, &vec![reach; bands], width, &mut dirty);
+            dirty
         };
-        // Segment 9 spans rows 72 to 80; band 4 holds rows 64 to 79, band 5 rows 80 to 95.
-        assert_eq!(changed(f64::NEG_INFINITY), [false; 8]);
-        let near = [false, false, false, false, true, true, false, false];
-        assert_eq!(changed(0.5), near);
-        assert_eq!(
-            changed(8.0),
-            [false, false, false, true, true, true, false, false]
-        );
-        // Another count of segments: every band.
+        // Segment 9 spans rows 72 to 80 at x 10 (old) and 10.5 (new); band 4 holds rows 64 to
+        // 79, band 5 rows 80 to 95.
+        assert_eq!(changed(f64::NEG_INFINITY), [Columns::NONE; 8]);
+        let near = |start, end| {
+            let cols = Columns { start, end };
+            [false, false, false, false, true, true, false, false].map(|n| {
+                if n {
+                    cols
+                } else {
+                    Columns::NONE
+                }
+            })
+        };
+        // Within 1.5 pixels (the reach and a pixel) of x 10 to 10.5: columns 8 to 12.
+        assert_eq!(changed(0.5), near(8, 13));
+        let mut far = near(1, 21);
+        far[3] = far[4];
+        assert_eq!(changed(8.0), far);
+        // Another count of segments: every column of every band.
         let fewer = PreparedLayer {
             nearest: NearestSegments::new(Vec::new()),
             ..segments_only(bands, None)
         };
-        let mut changed = vec![false; bands];
-        fewer.mark_changed_bands(&old, &[0.5; 8], &mut changed);
-        assert_eq!(changed, [true; 8]);
+        let mut dirty = vec![Columns::NONE; bands];
+        fewer.mark_changed_columns(&old, &[0.5; 8], width, &mut dirty);
+        assert_eq!(dirty, [Columns::all(width); 8]);
     }
 }

@@ -121,7 +121,7 @@ pub use overlay::draw_outlines;
 pub use view::{document_bounds, View};
 
 use gamut::RUN;
-use layer::{PreparedLayer, BAND};
+use layer::{Columns, PreparedLayer, BAND};
 use patches::ShapeCache;
 use view::ToPixels;
 
@@ -362,6 +362,10 @@ pub struct RenderInfo {
     /// How many bands of rows were drawn: all of them, unless a [`RenderCache`] held the last
     /// image and some bands draw exactly as before (they are copied from it).
     pub drawn_bands: usize,
+    /// How many pixels were drawn: all of them, unless a [`RenderCache`] held the last image
+    /// (the others are copied from it). Within a band drawn again, only the columns where some
+    /// layer may draw differently are drawn.
+    pub drawn_pixels: u64,
 }
 
 /// Renders `doc` into a new `f32` image: straight alpha, sRGB-encoded colour.
@@ -416,9 +420,14 @@ pub fn render_document_into<P: OutputPixel>(
 /// the faces within reach of what moved ([`LayerInfo::reused_faces`]), and builds again only
 /// the blocks of triangles next to them.
 ///
-/// It keeps the last image drawn, too: a band of rows where no layer's triangles, outline or
-/// outline colours changed is copied from it instead of drawn ([`RenderInfo::drawn_bands`]).
-/// The output buffer may be a fresh one each time; the copy costs one image of memory.
+/// It keeps the last image drawn, too: only the pixels where some layer's triangles, outline
+/// or outline colours changed are drawn, and the others are copied from it. Within a band of
+/// rows ([`RenderInfo::drawn_bands`]) that is a range of columns ([`RenderInfo::drawn_pixels`]):
+/// those of the triangles that differ, those within reach of a changed boundary segment, and
+/// from the leftmost changed outline line to the layer's right end (coverage is a prefix sum
+/// along the row). Each pixel is computed alone, so the image is the one drawing every pixel
+/// would give. The output buffer may be a fresh one each time; the copy costs one image of
+/// memory.
 #[derive(Default)]
 pub struct RenderCache {
     /// Local refinements by shape of neighbourhood, for all layers (cleared when they pile
@@ -559,16 +568,17 @@ fn render<P: OutputPixel>(
     let bands = h.div_ceil(BAND);
     // Entries per band of `Drawn::reach`.
     let nl = doc.layers.len().max(1);
-    // The bands to draw, and the last image drawn through the cache (taken out while drawing:
-    // a drawing cut short leaves none), whose other bands are as they would be drawn.
-    let mut changed = vec![true; bands];
+    // The columns of each band to draw, and the last image drawn through the cache (taken out
+    // while drawing: a drawing cut short leaves none), whose other pixels are as they would be
+    // drawn.
+    let mut dirty = vec![Columns::all(w); bands];
     let mut last: Option<Drawn> = None;
     let mut last_slot: Option<&mut Option<Drawn>> = None;
     let prepared: Vec<&layer::Prepared> = match cache {
         Some(cache) => {
             last = cache.drawn.take();
             if last.is_some() {
-                changed.fill(false);
+                dirty.fill(Columns::NONE);
             }
             for (i, fresh) in fresh.into_iter().enumerate() {
                 if let Some(p) = fresh {
@@ -578,10 +588,10 @@ fn render<P: OutputPixel>(
                     };
                     match cache.layers[i].as_ref().map(|(_, old)| (&old.1, &p.1)) {
                         Some((Some(old), Some(new))) if last.is_some() => {
-                            new.mark_changed_bands(old, &reach, &mut changed)
+                            new.mark_changed_columns(old, &reach, w, &mut dirty)
                         }
                         Some((None, None)) => {}
-                        _ => changed.fill(true),
+                        _ => dirty.fill(Columns::all(w)),
                     }
                     cache.layers[i] = Some((doc.layers[i].clone(), p));
                 }
@@ -592,7 +602,7 @@ fn render<P: OutputPixel>(
                 .and_then(|d| d.pixels.downcast_ref::<Vec<P>>())
                 .is_some_and(|p| p.len() == out.len());
             if !same_kind {
-                changed.fill(true);
+                dirty.fill(Columns::all(w));
                 last = Some(Drawn {
                     opts: opts.clone(),
                     pixels: Box::new(out.to_vec()),
@@ -645,13 +655,16 @@ fn render<P: OutputPixel>(
         [rgb[0] * a, rgb[1] * a, rgb[2] * a, a].map(|v| v as f32)
     });
     let start = Instant::now();
-    // Draws a band, and puts in `reach` (per layer of the document) what [`Band::reach`] gets.
-    let draw = |band: usize, chunk: &mut [P], reach: &mut [f64]| {
+    // Draws columns `cols` of a band, and puts in `reach` (per layer of the document) what
+    // [`Band::reach`] gets: for part of the band, the farther of that and what it held (the
+    // other columns' outline pixels keep theirs).
+    let draw = |band: usize, cols: Columns, chunk: &mut [P], reach: &mut [f64]| {
         let mut drawn_reach = vec![f64::NEG_INFINITY; layers.len()];
         Scratch::with(w, |scratch| {
             let job = Band {
                 wide: false,
                 index: band,
+                columns: cols.start..cols.end,
                 out: chunk,
                 layers: &layers,
                 opts,
@@ -660,9 +673,11 @@ fn render<P: OutputPixel>(
             };
             draw_band_dispatched(job, scratch)
         });
-        reach.fill(f64::NEG_INFINITY);
+        if cols == Columns::all(w) {
+            reach.fill(f64::NEG_INFINITY);
+        }
         for (&i, r) in layer_of.iter().zip(drawn_reach) {
-            reach[i] = r;
+            reach[i] = reach[i].max(r);
         }
     };
     let chunks = out.par_chunks_mut(4 * w * BAND).enumerate();
@@ -670,21 +685,34 @@ fn render<P: OutputPixel>(
         .as_mut()
         .and_then(|Drawn { pixels, reach, .. }| Some((pixels.downcast_mut::<Vec<P>>()?, reach)));
     match kept {
-        // Bands drawn again are kept for the next render; the others are taken from the last.
+        // Pixels drawn again are kept for the next render; the others are taken from the last.
         Some((pixels, reach)) => chunks
             .zip(pixels.par_chunks_mut(4 * w * BAND))
             .zip(reach.par_chunks_mut(nl))
             .for_each(|(((band, chunk), last), reach)| {
-                if changed[band] {
-                    draw(band, chunk, reach);
+                let cols = dirty[band];
+                if cols == Columns::all(w) {
+                    draw(band, cols, chunk, reach);
                     last.copy_from_slice(chunk);
-                } else {
-                    chunk.copy_from_slice(last);
+                    return;
+                }
+                chunk.copy_from_slice(last);
+                if !cols.is_empty() {
+                    draw(band, cols, chunk, reach);
+                    let window = 4 * cols.start..4 * cols.end;
+                    for (last, row) in last.chunks_exact_mut(4 * w).zip(chunk.chunks_exact(4 * w)) {
+                        last[window.clone()].copy_from_slice(&row[window.clone()]);
+                    }
                 }
             }),
-        None => chunks.for_each(|(band, chunk)| draw(band, chunk, &mut vec![0.0; nl])),
+        None => {
+            chunks.for_each(|(band, chunk)| draw(band, Columns::all(w), chunk, &mut vec![0.0; nl]))
+        }
     }
-    info.drawn_bands = changed.iter().filter(|&&c| c).count();
+    info.drawn_bands = dirty.iter().filter(|c| !c.is_empty()).count();
+    info.drawn_pixels = (0..bands)
+        .map(|b| dirty[b].len() as u64 * (h - b * BAND).min(BAND) as u64)
+        .sum();
     if let Some(slot) = last_slot {
         *slot = last;
     }
@@ -867,11 +895,13 @@ pub(crate) fn map_gamut_dispatched(gamut: GamutMapping, colours: &mut [[f64; 3]]
     gamut.apply_to_all_inlined(colours)
 }
 
-/// One band of the image to draw: rows `index * BAND ..`, whose pixels are `out`.
+/// One band of the image to draw: columns `columns` of rows `index * BAND ..`, whose pixels
+/// are `out` (the others are left as they are).
 struct Band<'a, P> {
     /// Whether this is the x86-64-v3 compilation, whose vectors some loops are written for.
     wide: bool,
     index: usize,
+    columns: Range<usize>,
     out: &'a mut [P],
     layers: &'a [&'a PreparedLayer],
     opts: &'a RenderOptions,
@@ -887,6 +917,7 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
     let Band {
         wide,
         index: band,
+        columns: Range { start: x0, end: x1 },
         out,
         layers,
         opts,
@@ -899,6 +930,9 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
     let rows = out.len() / (4 * w);
     let dither = opts.dither && P::DITHERED;
     let linear = opts.blend == BlendSpace::Linear;
+    // Every pixel is computed alone (its coverage's prefix sum from the layer's left end):
+    // drawing some columns gives them the bits drawing all would.
+    let whole_rows = x0 == 0 && x1 == w;
 
     // Rows no layer reaches (a canvas larger than the drawing) are the background: one pixel,
     // encoded once, unless dithering would give each of them its own noise.
@@ -906,16 +940,20 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
         let rgba = straight_srgb::<P>(&background.unwrap_or([0.0; 4]), linear);
         if !dither || rgba.iter().all(|&v| v == 0.0 || v == 1.0) {
             let pixel = each4(|ch| P::encode(rgba[ch], 0.0));
-            for px in out.chunks_exact_mut(4) {
-                px.copy_from_slice(&pixel);
+            for row in out.chunks_exact_mut(4 * w) {
+                for px in row[4 * x0..4 * x1].chunks_exact_mut(4) {
+                    px.copy_from_slice(&pixel);
+                }
             }
             return;
         }
     }
 
+    for r in 0..rows {
+        s.colour[r * w + x0..r * w + x1].fill([0.0; 4]);
+        s.opaque[r * w + x0..r * w + x1].fill(false);
+    }
     let colour = &mut s.colour[..w * rows];
-    colour.fill([0.0; 4]);
-    s.opaque[..w * rows].fill(false);
 
     // Front to back ("under"): a pixel that is already opaque is not evaluated again, and the
     // band stops once all of its pixels are.
@@ -923,7 +961,7 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
     // Whether no layer above has drawn into the band: its pixels are then all clear.
     let mut fresh = true;
     for (li, layer) in layers.iter().enumerate().rev() {
-        if opaque == w * rows {
+        if opaque == (x1 - x0) * rows {
             break;
         }
         let tris = layer.triangle_bins.get(band);
@@ -931,7 +969,12 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
         if lines.is_empty() {
             continue;
         }
+        // Coverage is summed over the layer's columns `c0..c1`, and shown over `d0..d1`.
         let (c0, c1) = layer.columns;
+        let (d0, d1) = (c0.max(x0), c1.min(x1));
+        if d0 >= d1 {
+            continue;
+        }
         let shading = Shading {
             space: layer.space,
             converter: gamut::RunConverter::new(layer.space, opts.gamut, opts.blend, wide),
@@ -953,15 +996,21 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
             })
         };
         for r in 0..rows {
-            s.covered[r * w + c0..r * w + c1].fill(false);
+            s.covered[r * w + d0..r * w + d1].fill(false);
         }
         let mut cursor = layer.triangles.cursor();
         for &ti in tris {
             let t = cursor.get(ti as usize);
+            if !whole_rows {
+                let (a, b) = t.columns(w);
+                if b <= d0 || a >= d1 {
+                    continue;
+                }
+            }
             let (r0, r1) = t.rows();
             let (j0, j1) = (r0.max(y0 as i64), r1.min((y0 + rows) as i64));
             t.for_each_span(j0..j1, w as i64, |j, a, b| {
-                let (a, b) = ((a as usize).max(c0), (b as usize).min(c1));
+                let (a, b) = ((a as usize).max(d0), (b as usize).min(d1));
                 if a >= b {
                     return;
                 }
@@ -981,8 +1030,8 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
             // may start there. Only columns `a..b` are covered at all.
             let (a, b) = s.accumulation.resolve(r, c0, c1, &mut s.coverage);
             // Bounds the loops below can see, so that they index without checks.
-            let coverage = &s.coverage[..c1];
-            let b = b.min(c1);
+            let coverage = &s.coverage[..d1];
+            let (a, b) = (a.max(d0), b.min(d1));
             let y = (y0 + r) as f64 + 0.5;
             let band = BandPixels {
                 row: r * w,
@@ -1004,11 +1053,13 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
         reach[li] = farthest.get();
     }
     if let Some(bg) = background {
-        for dst in colour.iter_mut() {
-            let keep = 1.0 - dst[3];
-            if keep > 0.0 {
-                for c in 0..4 {
-                    dst[c] += bg[c] * keep;
+        for row in colour.chunks_exact_mut(w) {
+            for dst in &mut row[x0..x1] {
+                let keep = 1.0 - dst[3];
+                if keep > 0.0 {
+                    for c in 0..4 {
+                        dst[c] += bg[c] * keep;
+                    }
                 }
             }
         }
@@ -1021,11 +1072,12 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
         .enumerate()
     {
         let y = (y0 + r) as u32;
+        let (row_out, row_colour) = (&mut row_out[4 * x0..4 * x1], &row_colour[x0..x1]);
         let pixels = row_out.chunks_exact_mut(4).zip(row_colour);
         if dither && !linear {
-            encode_row_dithered(row_out, row_colour, y);
+            encode_row_dithered(row_out, row_colour, x0, y);
         } else if dither {
-            for (x, (px, c)) in pixels.enumerate() {
+            for (x, (px, c)) in (x0..).zip(pixels) {
                 let rgba = straight_srgb::<P>(c, linear);
                 let noise = output::dither_noise(x as u32, y);
                 for ch in 0..4 {
@@ -1110,14 +1162,14 @@ fn encode_row_plain<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]]) {
     for_each_block(out, colour, opaque, one);
 }
 
-/// [`encode_row_plain`] with dither noise, for row `y`. In a block of opaque pixels the hashes
-/// come first (64-bit, one at a time), then the noise ([`output::dither_noise_block`]) and the
-/// encoding, which vectorise.
+/// [`encode_row_plain`] with dither noise, for the pixels of row `y` from column `x0`. In a
+/// block of opaque pixels the hashes come first (64-bit, one at a time), then the noise
+/// ([`output::dither_noise_block`]) and the encoding, which vectorise.
 // Always inlined: see `wide_vectors`.
 #[inline(always)]
-fn encode_row_dithered<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]], y: u32) {
+fn encode_row_dithered<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]], x0: usize, y: u32) {
     let opaque = |start: usize, c: &[[f32; 4]; BLOCK], dst: &mut [P; 4 * BLOCK]| {
-        let noise = output::dither_noise_block::<BLOCK, { 4 * BLOCK }>(start as u32, y);
+        let noise = output::dither_noise_block::<BLOCK, { 4 * BLOCK }>((x0 + start) as u32, y);
         // Alpha, at least 1, encodes as 1.
         for ((px, &v), &noise) in dst.iter_mut().zip(c.as_flattened()).zip(&noise) {
             let v = if P::SATURATES { v } else { v.clamp(0.0, 1.0) };
@@ -1126,7 +1178,7 @@ fn encode_row_dithered<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]], y: u3
     };
     let one = |i: usize, c: &[f32; 4], px: &mut [P]| {
         let rgba = straight_srgb::<P>(c, false);
-        let noise = output::dither_noise(i as u32, y);
+        let noise = output::dither_noise((x0 + i) as u32, y);
         for ch in 0..4 {
             px[ch] = P::encode(rgba[ch], noise[ch]);
         }
@@ -1578,7 +1630,7 @@ mod encode_tests {
 
         let y = 7;
         let mut dithered = vec![0u8; 4 * colour.len()];
-        encode_row_dithered(&mut dithered, &colour, y);
+        encode_row_dithered(&mut dithered, &colour, 0, y);
         let expected: Vec<u8> = colour
             .iter()
             .enumerate()

@@ -33,11 +33,11 @@ pub(crate) struct NearestSegments {
 }
 
 impl NearestSegments {
-    /// The row spans (lowest and highest `y`, pixels) of the segments that differ in any bit
+    /// The boxes (`[[x0, x1], [y0, y1]]`, pixels) of the segments that differ in any bit
     /// between `old` and this, in either, when both hold as many: the others keep their
     /// indices, and an answer (the least distance, then the least index, whatever the grid)
     /// changes only where a changed segment is as near. `None` for another count.
-    pub fn changed_rows(&self, old: &NearestSegments) -> Option<Vec<[f64; 2]>> {
+    pub fn changed_boxes(&self, old: &NearestSegments) -> Option<Vec<[[f64; 2]; 2]>> {
         if self.segments.len() != old.segments.len() {
             return None;
         }
@@ -47,13 +47,13 @@ impl NearestSegments {
                 [s.ca, s.cb, s.bump].map(|c| c.map(f32::to_bits)),
             )
         };
-        let rows = |s: &Segment| [s.a[1].min(s.b[1]), s.a[1].max(s.b[1])];
+        let span = |s: &Segment| [0, 1].map(|k| [s.a[k].min(s.b[k]), s.a[k].max(s.b[k])]);
         Some(
             self.segments
                 .iter()
                 .zip(&old.segments)
                 .filter(|(a, b)| bits(a) != bits(b))
-                .flat_map(|(a, b)| [rows(a), rows(b)])
+                .flat_map(|(a, b)| [span(a), span(b)])
                 .collect(),
         )
     }

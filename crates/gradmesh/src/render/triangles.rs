@@ -152,9 +152,9 @@ impl TriangleList {
         TriangleList::from_shared(chunks.into_iter().map(Arc::new).collect())
     }
 
-    /// The list of the triangles of `chunks`, in order (without copying them).
+    /// The list of the triangles of `chunks`, in order (without copying them). Empty chunks
+    /// are kept: a triangle's place (see [`TriangleCursor::get_placed`]) is that of its block.
     pub fn from_shared(chunks: Vec<Arc<Vec<Triangle>>>) -> TriangleList {
-        let chunks: Vec<_> = chunks.into_iter().filter(|c| !c.is_empty()).collect();
         let mut starts = Vec::with_capacity(chunks.len() + 1);
         let mut total = 0;
         starts.push(0);
@@ -172,6 +172,11 @@ impl TriangleList {
     /// Every triangle, in order.
     pub fn iter(&self) -> impl Iterator<Item = &Triangle> {
         self.chunks.iter().flat_map(|c| c.iter())
+    }
+
+    /// The triangle at place `(chunk, offset)`, if there is one.
+    pub fn at(&self, (chunk, offset): (usize, usize)) -> Option<&Triangle> {
+        self.chunks.get(chunk)?.get(offset)
     }
 
     /// A reader for increasing indices (a band's bin), each found in amortised constant time.
@@ -192,6 +197,13 @@ pub(crate) struct TriangleCursor<'a> {
 impl<'a> TriangleCursor<'a> {
     /// Triangle `i`; indices must not decrease between calls.
     pub fn get(&mut self, i: usize) -> &'a Triangle {
+        self.get_placed(i).1
+    }
+
+    /// Triangle `i` and its place: the index of its chunk and its offset there. Indices must
+    /// not decrease between calls.
+    #[inline]
+    pub fn get_placed(&mut self, i: usize) -> ((usize, usize), &'a Triangle) {
         let starts = &self.list.starts;
         // Skip ahead by galloping, then step: bins jump over many chunks at once.
         let mut step = 1;
@@ -202,7 +214,8 @@ impl<'a> TriangleCursor<'a> {
         while starts[self.chunk + 1] <= i {
             self.chunk += 1;
         }
-        &self.list.chunks[self.chunk][i - starts[self.chunk]]
+        let offset = i - starts[self.chunk];
+        ((self.chunk, offset), &self.list.chunks[self.chunk][offset])
     }
 }
 
@@ -387,6 +400,26 @@ impl Triangle {
     #[cfg(test)]
     pub fn is_quadratic(&self) -> bool {
         self.quadratic
+    }
+
+    /// Columns `[start, end)` of a `width`-pixel image holding every pixel centre inside
+    /// (with a pixel to spare on each side).
+    pub fn columns(&self, width: usize) -> (usize, usize) {
+        let xs = self.v.map(|v| v[0]);
+        let lo = xs
+            .iter()
+            .min()
+            .expect("three vertices")
+            .div_euclid(SUBPIXEL)
+            - 1;
+        let hi = xs
+            .iter()
+            .max()
+            .expect("three vertices")
+            .div_euclid(SUBPIXEL)
+            + 2;
+        let clamp = |x: i64| x.clamp(0, width as i64) as usize;
+        (clamp(lo), clamp(hi))
     }
 
     /// The first row and one past the last whose pixel centres may lie inside.
