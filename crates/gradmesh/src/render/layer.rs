@@ -152,8 +152,7 @@ impl PreparedLayer {
     /// Widens, in `dirty` (columns per band of a `width`-pixel image), the columns where this
     /// layer may draw differently from `old`, its last preparation:
     /// - where a triangle of either lies that the other does not hold, bit for bit, at the
-    ///   same place (chunk and offset: triangles are drawn in the order of their places, so a
-    ///   pixel no such triangle covers shows the same triangle in both);
+    ///   same place ([`TriangleList::for_each_moved`]);
     /// - from the leftmost outline line that differs in any bit to the layer's right end
     ///   (coverage is a prefix sum along the row: to the left of a change it is the same sum,
     ///   to the right only the same up to rounding);
@@ -182,6 +181,21 @@ impl PreparedLayer {
             return;
         };
         let column = |x: f64| x.clamp(0.0, width as f64) as usize;
+        let bands = dirty.len();
+        for (layer, other) in [(self, old), (old, self)] {
+            layer.triangles.for_each_moved(&other.triangles, |t| {
+                let (r0, r1) = t.rows();
+                if r1 <= r0 {
+                    return;
+                }
+                let first = (r0.max(0) as usize / BAND).min(bands);
+                let end = ((r1 - 1).max(0) as usize / BAND + 1).min(bands);
+                let (a, b) = t.columns(width);
+                for dirty in &mut dirty[first..end] {
+                    dirty.include(a, b);
+                }
+            });
+        }
         let line = |l: &Line| [l.p0, l.p1].map(|p| p.map(f64::to_bits));
         for (band, dirty) in dirty.iter_mut().enumerate() {
             if *dirty == all {
@@ -195,22 +209,6 @@ impl PreparedLayer {
                 if y0 <= bottom + margin && y1 >= top - margin {
                     let (a, b) = (x0 - margin, x1 + margin);
                     dirty.include(column(a.floor()), column(b.ceil() + 1.0));
-                }
-            }
-
-            for (layer, other) in [(self, old), (old, self)] {
-                let mut cursor = layer.triangles.cursor();
-                for &i in layer.triangle_bins.get(band) {
-                    let (place, t) = cursor.get_placed(i as usize);
-                    // Blocks of faces kept from the last preparation hold the same objects.
-                    let same = other
-                        .triangles
-                        .at(place)
-                        .is_some_and(|u| std::ptr::eq(t, u) || t.same_bits(u));
-                    if !same {
-                        let (a, b) = t.columns(width);
-                        dirty.include(a, b);
-                    }
                 }
             }
 

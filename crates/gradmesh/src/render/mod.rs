@@ -1022,13 +1022,18 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
             });
         }
         for &li in lines {
-            s.accumulation
-                .add(y0 as i64, rows, &layer.lines[li as usize]);
+            let line = &layer.lines[li as usize];
+            // A line changes the cells from the one holding its left end: one right of the
+            // columns drawn changes no sum they take.
+            if !whole_rows && line.p0[0].min(line.p1[0]) >= d1 as f64 {
+                continue;
+            }
+            s.accumulation.add(y0 as i64, rows, line);
         }
         for r in 0..rows {
             // Left of the layer's columns the accumulation is all zeros, so its prefix sums
             // may start there. Only columns `a..b` are covered at all.
-            let (a, b) = s.accumulation.resolve(r, c0, c1, &mut s.coverage);
+            let (a, b) = s.accumulation.resolve(r, c0, d1, &mut s.coverage);
             // Bounds the loops below can see, so that they index without checks.
             let coverage = &s.coverage[..d1];
             let (a, b) = (a.max(d0), b.min(d1));

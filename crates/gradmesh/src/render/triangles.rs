@@ -153,7 +153,7 @@ impl TriangleList {
     }
 
     /// The list of the triangles of `chunks`, in order (without copying them). Empty chunks
-    /// are kept: a triangle's place (see [`TriangleCursor::get_placed`]) is that of its block.
+    /// are kept: a chunk's place is that of its block (see [`TriangleList::for_each_moved`]).
     pub fn from_shared(chunks: Vec<Arc<Vec<Triangle>>>) -> TriangleList {
         let mut starts = Vec::with_capacity(chunks.len() + 1);
         let mut total = 0;
@@ -174,9 +174,25 @@ impl TriangleList {
         self.chunks.iter().flat_map(|c| c.iter())
     }
 
-    /// The triangle at place `(chunk, offset)`, if there is one.
-    pub fn at(&self, (chunk, offset): (usize, usize)) -> Option<&Triangle> {
-        self.chunks.get(chunk)?.get(offset)
+    /// Calls `f` with each triangle that `other` does not hold, bit for bit, at the same place
+    /// (the same offset in the same chunk). Triangles are drawn in the order of their places,
+    /// so a pixel that no such triangle of either list covers shows the same triangle in both.
+    /// Chunks both lists share (a block of faces an edit left alone) are skipped whole.
+    pub fn for_each_moved(&self, other: &TriangleList, mut f: impl FnMut(&Triangle)) {
+        for (k, chunk) in self.chunks.iter().enumerate() {
+            let theirs = other.chunks.get(k);
+            if theirs.is_some_and(|c| Arc::ptr_eq(c, chunk)) {
+                continue;
+            }
+            for (i, t) in chunk.iter().enumerate() {
+                if !theirs
+                    .and_then(|c| c.get(i))
+                    .is_some_and(|u| t.same_bits(u))
+                {
+                    f(t);
+                }
+            }
+        }
     }
 
     /// A reader for increasing indices (a band's bin), each found in amortised constant time.
@@ -197,13 +213,6 @@ pub(crate) struct TriangleCursor<'a> {
 impl<'a> TriangleCursor<'a> {
     /// Triangle `i`; indices must not decrease between calls.
     pub fn get(&mut self, i: usize) -> &'a Triangle {
-        self.get_placed(i).1
-    }
-
-    /// Triangle `i` and its place: the index of its chunk and its offset there. Indices must
-    /// not decrease between calls.
-    #[inline]
-    pub fn get_placed(&mut self, i: usize) -> ((usize, usize), &'a Triangle) {
         let starts = &self.list.starts;
         // Skip ahead by galloping, then step: bins jump over many chunks at once.
         let mut step = 1;
@@ -214,8 +223,7 @@ impl<'a> TriangleCursor<'a> {
         while starts[self.chunk + 1] <= i {
             self.chunk += 1;
         }
-        let offset = i - starts[self.chunk];
-        ((self.chunk, offset), &self.list.chunks[self.chunk][offset])
+        &self.list.chunks[self.chunk][i - starts[self.chunk]]
     }
 }
 
