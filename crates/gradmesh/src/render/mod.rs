@@ -949,11 +949,17 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
         }
     }
 
-    for r in 0..rows {
-        s.colour[r * w + x0..r * w + x1].fill([0.0; 4]);
-        s.opaque[r * w + x0..r * w + x1].fill(false);
-    }
     let colour = &mut s.colour[..w * rows];
+    if whole_rows {
+        // One call each (a loop per row was compiled into a slower inline fill).
+        colour.fill([0.0; 4]);
+        s.opaque[..w * rows].fill(false);
+    } else {
+        for r in 0..rows {
+            colour[r * w + x0..r * w + x1].fill([0.0; 4]);
+            s.opaque[r * w + x0..r * w + x1].fill(false);
+        }
+    }
 
     // Front to back ("under"): a pixel that is already opaque is not evaluated again, and the
     // band stops once all of its pixels are.
