@@ -35,18 +35,19 @@ const IGNORED_TAGS: [&str; 2] = [
     "facevaryingpropagatecorners",
 ];
 
-fn parse_num(token: &str, what: &str, line: usize) -> Result<f64, Error> {
+// `what` names the field for an error message, built only when there is one.
+fn parse_num(token: &str, what: impl Fn() -> String, line: usize) -> Result<f64, Error> {
     let v = token.parse::<f64>().map_err(|_| {
         syntax_error(
             line,
-            format!("{what}: expected a number, found \"{token}\""),
+            format!("{}: expected a number, found \"{token}\"", what()),
         )
     })?;
     if !v.is_finite() {
         return Err(error_at(
             line,
             ErrorKind::NotFinite {
-                what: what.to_string(),
+                what: what(),
                 value: token.to_string(),
             },
         ));
@@ -107,7 +108,7 @@ fn parse_tag<'a>(t: &[&'a str], line: usize) -> Result<Tag<'a>, Error> {
     let floats = args[ni..ni + nf]
         .iter()
         .enumerate()
-        .map(|(k, a)| parse_num(a, &format!("tag {name}: number {}", k + 1), line))
+        .map(|(k, a)| parse_num(a, || format!("tag {name}: number {}", k + 1), line))
         .collect::<Result<_, _>>()?;
     Ok(Tag {
         name,
@@ -186,7 +187,9 @@ pub fn read_obj_with(text: &str, limits: &Limits) -> Result<GradientMesh, Error>
                 let values: Vec<f64> = t[1..]
                     .iter()
                     .enumerate()
-                    .map(|(k, s)| parse_num(s, &format!("vertex {} value {}", v + 1, k + 1), line))
+                    .map(|(k, s)| {
+                        parse_num(s, || format!("vertex {} value {}", v + 1, k + 1), line)
+                    })
                     .collect::<Result<_, _>>()?;
                 let has_colour = match values.len() {
                     3 => false,

@@ -55,27 +55,32 @@ impl<'a> Lines<'a> {
     }
 }
 
-fn parse_int(token: &str, what: &str, line: usize) -> Result<u64, Error> {
+// `what` names the field for an error message: built only when there is one (formatting it
+// for every token was most of the time reading a file took).
+fn parse_int(token: &str, what: impl Fn() -> String, line: usize) -> Result<u64, Error> {
     token.parse::<u64>().map_err(|_| {
         syntax_error(
             line,
-            format!("{what}: expected a whole number >= 0, found \"{token}\""),
+            format!(
+                "{}: expected a whole number >= 0, found \"{token}\"",
+                what()
+            ),
         )
     })
 }
 
-fn parse_num(token: &str, what: &str, line: usize) -> Result<f64, Error> {
+fn parse_num(token: &str, what: impl Fn() -> String, line: usize) -> Result<f64, Error> {
     let v = token.parse::<f64>().map_err(|_| {
         syntax_error(
             line,
-            format!("{what}: expected a number, found \"{token}\""),
+            format!("{}: expected a number, found \"{token}\"", what()),
         )
     })?;
     if !v.is_finite() {
         return Err(error_at(
             line,
             ErrorKind::NotFinite {
-                what: what.to_string(),
+                what: what(),
                 value: token.to_string(),
             },
         ));
@@ -132,8 +137,8 @@ pub fn read_off_with(text: &str, limits: &Limits) -> Result<GradientMesh, Error>
             ),
         ));
     }
-    let nv = parse_int(t[0], "the number of vertices", line)?;
-    let nf = parse_int(t[1], "the number of faces", line)?;
+    let nv = parse_int(t[0], || "the number of vertices".into(), line)?;
+    let nf = parse_int(t[1], || "the number of faces".into(), line)?;
     check_count("the number of vertices", nv, limits.points).map_err(|e| located(e, line))?;
     check_count("the number of faces", nf, limits.faces).map_err(|e| located(e, line))?;
     let colour_space = match t[2] {
@@ -171,14 +176,18 @@ pub fn read_off_with(text: &str, limits: &Limits) -> Result<GradientMesh, Error>
                 ),
             ));
         }
-        let x = parse_num(t[0], &what("x"), line)?;
-        let y = parse_num(t[1], &what("y"), line)?;
-        parse_num(t[2], &what("z"), line)?;
+        let x = parse_num(t[0], || what("x"), line)?;
+        let y = parse_num(t[1], || what("y"), line)?;
+        parse_num(t[2], || what("z"), line)?;
         let mut colour = [0.0; 3];
         for (k, c) in colour.iter_mut().enumerate() {
-            *c = parse_num(t[3 + k], &what(&format!("colour channel {}", k + 1)), line)?;
+            *c = parse_num(
+                t[3 + k],
+                || what(&format!("colour channel {}", k + 1)),
+                line,
+            )?;
         }
-        let n = parse_int(t[6], &what("the number of neighbours n"), line)?;
+        let n = parse_int(t[6], || what("the number of neighbours n"), line)?;
         if n > t.len() as u64 {
             return Err(syntax_error(
                 line,
@@ -207,7 +216,7 @@ pub fn read_off_with(text: &str, limits: &Limits) -> Result<GradientMesh, Error>
         let n = n as usize;
         let mut seen = HashSet::with_capacity(n);
         for k in 0..n {
-            let j = parse_int(t[7 + k], &what(&format!("neighbour {}", k + 1)), line)?;
+            let j = parse_int(t[7 + k], || what(&format!("neighbour {}", k + 1)), line)?;
             if j >= nv as u64 {
                 return Err(syntax_error(
                     line,
@@ -231,19 +240,19 @@ pub fn read_off_with(text: &str, limits: &Limits) -> Result<GradientMesh, Error>
             }
             let dx = parse_num(
                 t[7 + n + 2 * k],
-                &what(&format!("handle {} dx", k + 1)),
+                || what(&format!("handle {} dx", k + 1)),
                 line,
             )?;
             let dy = parse_num(
                 t[8 + n + 2 * k],
-                &what(&format!("handle {} dy", k + 1)),
+                || what(&format!("handle {} dy", k + 1)),
                 line,
             )?;
             mesh.handles.insert((v as u32, j as u32), Vec2::new(dx, dy));
             handle_lines.push((v as u32, j as u32, line));
         }
         for (k, token) in t[7 + 3 * n..].iter().enumerate() {
-            parse_num(token, &what(&format!("unused value {}", k + 1)), line)?;
+            parse_num(token, || what(&format!("unused value {}", k + 1)), line)?;
         }
         mesh.points
             .push(ControlPoint::new(Point::new(x, y), colour));
@@ -258,7 +267,7 @@ pub fn read_off_with(text: &str, limits: &Limits) -> Result<GradientMesh, Error>
                 format!("the line of face {f} (the header declares {nf} faces)"),
             )
         })?;
-        let k = parse_int(t[0], &format!("face {f}: the number of corners"), line)?;
+        let k = parse_int(t[0], || format!("face {f}: the number of corners"), line)?;
         if k < 3 {
             return Err(syntax_error(
                 line,
@@ -281,7 +290,7 @@ pub fn read_off_with(text: &str, limits: &Limits) -> Result<GradientMesh, Error>
         // A set, not a search of the corners so far: faces may have millions of corners.
         let mut seen_corners = HashSet::with_capacity(t.len() - 1);
         for (c, token) in t[1..].iter().enumerate() {
-            let i = parse_int(token, &format!("face {f}: corner {c}"), line)?;
+            let i = parse_int(token, || format!("face {f}: corner {c}"), line)?;
             if i >= nv as u64 {
                 return Err(error_at(
                     line,
