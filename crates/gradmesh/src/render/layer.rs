@@ -54,6 +54,13 @@ const ADAPTIVE_COLOUR_MARGIN: f64 = 0.75;
 const OUTLINE_TOLERANCE_PX: f64 = 0.002;
 const REFERENCE_OUTLINE_TOLERANCE_PX: f64 = 0.0002;
 
+/// The first and last band holding rows `r0..r1` of an image `h` rows high, which they must
+/// overlap. Triangles, outline lines and the edits' changes are binned alike.
+fn bands_of_rows((r0, r1): (i64, i64), h: i64) -> (usize, usize) {
+    debug_assert!(r0 < r1 && r1 > 0 && r0 < h);
+    (r0.max(0) as usize / BAND, (r1.min(h) - 1) as usize / BAND)
+}
+
 /// Item indices grouped by band (compressed rows).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Bins {
@@ -181,17 +188,17 @@ impl PreparedLayer {
             return;
         };
         let column = |x: f64| x.clamp(0.0, width as f64) as usize;
-        let bands = dirty.len();
+        // The rows of the bands (the last may reach past the image: the bands are the same).
+        let rows = (dirty.len() * BAND) as i64;
         for (layer, other) in [(self, old), (old, self)] {
             layer.triangles.for_each_moved(&other.triangles, |t| {
                 let (r0, r1) = t.rows();
-                if r1 <= r0 {
+                if r1 <= r0.max(0) || r0 >= rows {
                     return;
                 }
-                let first = (r0.max(0) as usize / BAND).min(bands);
-                let end = ((r1 - 1).max(0) as usize / BAND + 1).min(bands);
+                let (first, last) = bands_of_rows((r0, r1), rows);
                 let (a, b) = t.columns(width);
-                for dirty in &mut dirty[first..end] {
+                for dirty in &mut dirty[first..=last] {
                     dirty.include(a, b);
                 }
             });
@@ -882,8 +889,7 @@ pub(crate) fn prepare(
         .iter()
         .enumerate()
         .map(|(i, tri)| {
-            let a = tri.rows().0.max(0) as usize / BAND;
-            let b = (tri.rows().1.min(h) - 1) as usize / BAND;
+            let (a, b) = bands_of_rows(tri.rows(), h);
             (i as u32, a, b)
         })
         .collect();
@@ -919,8 +925,7 @@ pub(crate) fn prepare(
         if l.p0[0] >= w as f64 && l.p1[0] >= w as f64 {
             continue;
         }
-        let a = r0.max(0) as usize / BAND;
-        let b = (r1.min(h) - 1) as usize / BAND;
+        let (a, b) = bands_of_rows((r0, r1), h);
         line_ranges.push((lines.len() as u32, a, b));
         lines.push(l);
     }

@@ -414,18 +414,8 @@ impl Triangle {
     /// (with a pixel to spare on each side).
     pub fn columns(&self, width: usize) -> (usize, usize) {
         let xs = self.v.map(|v| v[0]);
-        let lo = xs
-            .iter()
-            .min()
-            .expect("three vertices")
-            .div_euclid(SUBPIXEL)
-            - 1;
-        let hi = xs
-            .iter()
-            .max()
-            .expect("three vertices")
-            .div_euclid(SUBPIXEL)
-            + 2;
+        let lo = xs[0].min(xs[1]).min(xs[2]).div_euclid(SUBPIXEL) - 1;
+        let hi = xs[0].max(xs[1]).max(xs[2]).div_euclid(SUBPIXEL) + 2;
         let clamp = |x: i64| x.clamp(0, width as i64) as usize;
         (clamp(lo), clamp(hi))
     }
