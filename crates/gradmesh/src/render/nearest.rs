@@ -158,48 +158,55 @@ impl NearestSegments {
                 *best = Some((d2, s, t));
             }
         };
-        let ci = ((p[0] - self.origin[0]) / self.cell).floor();
-        let cj = ((p[1] - self.origin[1]) / self.cell).floor();
-        let inside = ci >= 0.0 && cj >= 0.0 && (ci as usize) < self.nx && (cj as usize) < self.ny;
-        if !inside {
-            for s in 0..self.segments.len() {
-                consider(s, &mut best);
+        // The search starts from the cell nearest to `p`: outline pixels just outside the
+        // segments' box (every pixel beside a rectangle's sides) used to test every segment.
+        let cell_of = |x: f64, o: f64, n: usize| {
+            let c = ((x - o) / self.cell).floor();
+            if c.is_nan() {
+                0
+            } else {
+                c.clamp(0.0, (n - 1) as f64) as i64
             }
-        } else {
-            let (ci, cj) = (ci as i64, cj as i64);
-            let max_r = self.nx.max(self.ny) as i64;
-            for r in 0..=max_r {
-                for j in (cj - r)..=(cj + r) {
-                    for i in (ci - r)..=(ci + r) {
-                        let on_ring = (j - cj).abs() == r || (i - ci).abs() == r;
-                        if !on_ring || i < 0 || j < 0 || i >= self.nx as i64 || j >= self.ny as i64
-                        {
-                            continue;
-                        }
-                        let c = j as usize * self.nx + i as usize;
-                        for &s in
-                            &self.items[self.offsets[c] as usize..self.offsets[c + 1] as usize]
-                        {
-                            consider(s as usize, &mut best);
-                        }
+        };
+        let ci = cell_of(p[0], self.origin[0], self.nx);
+        let cj = cell_of(p[1], self.origin[1], self.ny);
+        let (nx, ny) = (self.nx as i64, self.ny as i64);
+        for r in 0..=nx.max(ny) {
+            for j in (cj - r).max(0)..=(cj + r).min(ny - 1) {
+                for i in (ci - r).max(0)..=(ci + r).min(nx - 1) {
+                    if (j - cj).abs() != r && (i - ci).abs() != r {
+                        continue;
+                    }
+                    let c = j as usize * self.nx + i as usize;
+                    for &s in &self.items[self.offsets[c] as usize..self.offsets[c + 1] as usize] {
+                        consider(s as usize, &mut best);
                     }
                 }
-                // Any edge not seen yet lies outside the square of rings 0..=r.
-                if let Some((d2, _, _)) = best {
-                    let left = self.origin[0] + (ci - r) as f64 * self.cell;
-                    let top = self.origin[1] + (cj - r) as f64 * self.cell;
-                    let right = self.origin[0] + (ci + r + 1) as f64 * self.cell;
-                    let bottom = self.origin[1] + (cj + r + 1) as f64 * self.cell;
-                    let margin = (p[0] - left)
-                        .min(right - p[0])
-                        .min(p[1] - top)
-                        .min(bottom - p[1]);
-                    // Strictly nearer (with room for rounding): an unseen edge at the same
-                    // distance with a lower index would win, and the answer would then depend
-                    // on the grid, which depends on every edge.
-                    if d2 < margin * margin * (1.0 - 1e-9) {
-                        break;
-                    }
+            }
+            // An edge not seen yet lies in a cell of the grid beyond one of the sides of the
+            // square of rings 0..=r that still has cells beyond it; none is left when no side
+            // has.
+            if let Some((d2, _, _)) = best {
+                let edge = |k: i64, o: f64| o + k as f64 * self.cell;
+                let mut margin = f64::INFINITY;
+                if ci - r > 0 {
+                    margin = margin.min(p[0] - edge(ci - r, self.origin[0]));
+                }
+                if ci + r < nx - 1 {
+                    margin = margin.min(edge(ci + r + 1, self.origin[0]) - p[0]);
+                }
+                if cj - r > 0 {
+                    margin = margin.min(p[1] - edge(cj - r, self.origin[1]));
+                }
+                if cj + r < ny - 1 {
+                    margin = margin.min(edge(cj + r + 1, self.origin[1]) - p[1]);
+                }
+                // Strictly nearer (with room for rounding): an unseen edge at the same
+                // distance with a lower index would win, and the answer would then depend
+                // on the grid, which depends on every edge.
+                if margin == f64::INFINITY || (margin > 0.0 && d2 < margin * margin * (1.0 - 1e-9))
+                {
+                    break;
                 }
             }
         }
@@ -217,6 +224,68 @@ impl NearestSegments {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The answer is the brute force's, bit for bit (least distance, then least index), for
+    /// points inside the segments' box and outside it (beside a rectangle's sides, where
+    /// the outline pixels of a rectangular mesh lie), far and near.
+    #[test]
+    fn the_grid_search_gives_the_brute_force_answer_inside_and_outside_the_box() {
+        // A rectangle's outline of 4 x 300 edges, 0.5 px long, colours varying along it.
+        let mut corners = Vec::new();
+        let n = 300;
+        for k in 0..4 * n {
+            let (side, t) = (k / n, (k % n) as f64 * 0.5);
+            corners.push(match side {
+                0 => [10.0 + t, 20.0],
+                1 => [160.0, 20.0 + t],
+                2 => [160.0 - t, 170.0],
+                _ => [10.0, 170.0 - t],
+            });
+        }
+        let segs: Vec<Segment> = (0..4 * n)
+            .map(|k| Segment {
+                a: corners[k],
+                b: corners[(k + 1) % (4 * n)],
+                ca: [k as f32, 0.5, 0.25, 1.0],
+                cb: [(k + 1) as f32, 0.5, 0.25, 1.0],
+                bump: [0.0, 0.1, 0.0, 0.0],
+            })
+            .collect();
+        let grid = NearestSegments::new(segs.clone());
+        let brute = |p: [f64; 2]| {
+            let mut best: Option<(f64, usize, f64)> = None;
+            for s in 0..segs.len() {
+                let (d2, t) = grid.distance2(s, p);
+                if best.is_none_or(|(bd, bs, _)| d2 < bd || (d2 == bd && s < bs)) {
+                    best = Some((d2, s, t));
+                }
+            }
+            best.unwrap()
+        };
+        let mut checked = 0;
+        for j in 0..=190 {
+            for i in 0..=180 {
+                // Pixel centres around and inside the rectangle, and a few far away.
+                let p = [i as f64 + 0.5 - 5.0, j as f64 + 0.5 - 5.0];
+                let p = if (i + j) % 97 == 0 {
+                    [p[0] * 7.0, p[1] * -3.0]
+                } else {
+                    p
+                };
+                let (d2, s, t) = brute(p);
+                let (got, distance) = grid.attributes_and_distance_at(p).unwrap();
+                let seg = &segs[s];
+                let t = t as f32;
+                let want: [f32; 4] = std::array::from_fn(|k| {
+                    seg.ca[k] + t * (seg.cb[k] - seg.ca[k]) + seg.bump[k] * (t * (1.0 - t))
+                });
+                assert_eq!(got.map(f32::to_bits), want.map(f32::to_bits), "at {p:?}");
+                assert_eq!(distance.to_bits(), d2.sqrt().to_bits(), "at {p:?}");
+                checked += 1;
+            }
+        }
+        assert!(checked > 30_000);
+    }
 
     #[test]
     fn finds_the_nearest_edge_and_interpolates() {
