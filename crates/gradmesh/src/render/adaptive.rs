@@ -66,7 +66,7 @@ const QUADRATIC_MAX_LINEAR_ERROR: f64 = 8.0;
 
 /// The slowest that linear pieces' colour error is taken to fall per level for a face that
 /// does not fold but may border one: where the surface folds, about 0.6 was seen (the floor
-/// on counted cell sizes, seventh round of `docs/performance.md`); elsewhere it quarters.
+/// on counted cell sizes, seventh round of `docs/performance-history.md`); elsewhere it quarters.
 const LINEAR_RATE_NEAR_FOLDS: f64 = 0.6;
 
 /// The base level for a layer that can cover `pixels` pixels ([`covered_pixels`]):
