@@ -19,6 +19,8 @@ use gradmesh::render::{
 };
 use gradmesh::Document;
 
+mod common;
+
 const SIZE: u32 = 1024;
 
 fn examples() -> Vec<(String, PathBuf)> {
@@ -125,6 +127,15 @@ fn bench_editing(c: &mut Criterion) {
     g.bench_function("from_scratch", |b| {
         b.iter(|| render_document_into(black_box(&doc), &opts, &mut buffer).unwrap())
     });
+    // The drawing stage alone (every pixel, from prepared layers); preparing is the rest of
+    // `from_scratch`.
+    {
+        let (mut opts, mut cache) = (opts.clone(), RenderCache::new());
+        common::check_draws_only(&doc, &mut opts, &mut cache, &mut buffer);
+        g.bench_function("draw_only", |b| {
+            b.iter(|| common::draw_again(black_box(&doc), &mut opts, &mut cache, &mut buffer))
+        });
+    }
     // An edit moves a point of one layer back and forth, so every iteration prepares that
     // layer again and takes the others from the cache.
     for (name, layer) in [("edit_top_layer", 5), ("edit_densest_layer", 3)] {

@@ -14,10 +14,11 @@ use std::time::Duration;
 
 use cairo::{Context, Format, ImageSurface, Mesh, MeshCorner};
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use gradmesh::render::{render_document_into, RenderOptions, View};
+use gradmesh::render::{render_document_into, RenderCache, RenderOptions, View};
 
 mod common;
 use common::wavy_grid::{colour, document, grid, handle, N};
+use common::{check_draws_only, draw_again};
 
 const SIZE: u32 = 1024;
 
@@ -69,6 +70,12 @@ fn bench(c: &mut Criterion) {
     g.bench_function("gradmesh", |b| {
         b.iter(|| render_document_into(black_box(&doc), &opts, &mut buffer).unwrap())
     });
+    // Its drawing stage alone (every pixel, from the prepared layer).
+    let (mut draw_opts, mut cache) = (opts.clone(), RenderCache::new());
+    check_draws_only(&doc, &mut draw_opts, &mut cache, &mut buffer);
+    g.bench_function("gradmesh_draw_only", |b| {
+        b.iter(|| draw_again(black_box(&doc), &mut draw_opts, &mut cache, &mut buffer))
+    });
     g.bench_function("cairo_mesh_pattern", |b| {
         b.iter(|| {
             let cr = Context::new(&surface).unwrap();
@@ -101,6 +108,9 @@ fn bench(c: &mut Criterion) {
     let ours = median(&mut || {
         render_document_into(black_box(&doc), &opts, &mut buffer).unwrap();
     });
+    let draw = median(&mut || {
+        draw_again(black_box(&doc), &mut draw_opts, &mut cache, &mut buffer);
+    });
     let cairo = median(&mut || {
         let cr = Context::new(&surface).unwrap();
         cr.set_source(black_box(&mesh)).unwrap();
@@ -112,12 +122,15 @@ fn bench(c: &mut Criterion) {
         }
     });
     println!(
-        "medians of 15: gradmesh {:.1} ms, cairo {:.1} ms, floor {:.2} ms; \
-         gradmesh / cairo = {:.2} (target 0.25), gradmesh / floor = {:.0}, cairo / floor = {:.0}",
+        "medians of 15: gradmesh {:.1} ms (drawing alone {:.1} ms), cairo {:.1} ms, floor {:.2} ms; \
+         gradmesh / cairo = {:.2} (target 0.25; drawing alone {:.2}), gradmesh / floor = {:.0}, \
+         cairo / floor = {:.0}",
         ours * 1e3,
+        draw * 1e3,
         cairo * 1e3,
         floor * 1e3,
         ours / cairo,
+        draw / cairo,
         ours / floor,
         cairo / floor
     );
