@@ -828,12 +828,16 @@ pub(super) fn tessellate(
     // refined spot, often a fold near a singular point, follow its shape closely). A coarser
     // face then fans its boundary cells out to the edge's extra samples (step 3).
     let edge_counts = |plans: &[Arc<Plan>]| -> Vec<usize> {
+        // The counts side by side first: read through each plan's pointer, edge by edge, they
+        // were a cache miss each (for 90,000 faces, 5 ms on one core).
+        let counts: Vec<usize> = plans.par_iter().map(|p| p.n).collect();
         (0..t.edge_count())
+            .into_par_iter()
             .map(|e| {
                 t.edge_faces(e)
                     .iter()
                     .filter(|&&g| (g as usize) < nf)
-                    .map(|&g| plans[g as usize].n)
+                    .map(|&g| counts[g as usize])
                     .max()
                     .unwrap_or(1)
             })
@@ -997,6 +1001,7 @@ pub(super) fn tessellate(
     // [`super::quadratic`]), which both sides compute alike; elsewhere they are the mean of
     // the segment's ends, the colour a linear face (or its fan) draws along it.
     let edge_quadratic: Vec<bool> = (0..t.edge_count())
+        .into_par_iter()
         .map(|e| {
             t.edge_faces(e)
                 .iter()
@@ -1301,17 +1306,23 @@ pub(super) fn tessellate(
         }
     }
 
-    let finest = plans.iter().map(|p| p.n).max().unwrap_or(1);
+    // The figures over the faces, in one pass (each plan is a pointer to follow).
+    let (mut finest, mut quads, mut capped, mut estimated) = (1, 0, false, false);
+    let mut measured = Measure::default();
+    for p in &plans {
+        finest = finest.max(p.n);
+        quads += p.n * p.n;
+        capped |= p.capped;
+        estimated |= p.estimated;
+        measured = measured.max(p.measured);
+    }
     Some(Tessellation {
         base_level: k0,
         level: k0 + finest.trailing_zeros() as usize,
-        quads: plans.iter().map(|p| p.n * p.n).sum(),
-        capped: plans.iter().any(|p| p.capped),
-        measured: plans
-            .iter()
-            .map(|p| p.measured)
-            .fold(Measure::default(), Measure::max),
-        estimated: plans.iter().any(|p| p.estimated),
+        quads,
+        capped,
+        measured,
+        estimated,
         triangles,
         segments,
         bounds,
