@@ -280,12 +280,13 @@ pub fn ternary_topology(t: &Topology) -> Topology {
             ring_edges,
         )
     };
-    // A level 1 of nine times the corners: concurrently where that pays (see `subdivide`).
-    let ((face_offsets, face_verts, face_edges), ((edge_verts, edge_faces), rings)) =
+    // A level 1 of nine times the corners: concurrently where that pays, the rings (the
+    // largest part) against faces and edges (see `subdivide`).
+    let (rings, ((face_offsets, face_verts, face_edges), (edge_verts, edge_faces))) =
         if 9 * nc < PARALLEL_MIN_CORNERS {
-            (faces(), (edges(), rings()))
+            (rings(), (faces(), edges()))
         } else {
-            rayon::join(faces, || rayon::join(edges, rings))
+            rayon::join(rings, || rayon::join(faces, edges))
         };
     let (ring_offsets, ring_faces, ring_corners, edge_ring_offsets, ring_edges) = rings;
 
