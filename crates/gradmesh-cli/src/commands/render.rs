@@ -121,8 +121,11 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         Pixels::Sixteen(data) => render::encode_png_rgba16(w, h, data)?,
         Pixels::Eight(data) => render::encode_png_rgba8(w, h, data)?,
     };
+    let encoded = start.elapsed();
     drop(pixels);
+    let start = Instant::now();
     formats::write_atomic(&args.output, &png)?;
+    // Written through a temporary file, synced to disk before it replaces the output.
     let written = start.elapsed();
 
     if args.timings {
@@ -136,7 +139,8 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         );
         eprintln!("  prepare  {:9.2} ms", ms(info.timings.prepare));
         eprintln!("  draw     {:9.2} ms", ms(info.timings.draw));
-        eprintln!("encode     {:9.2} ms", ms(written));
+        eprintln!("encode     {:9.2} ms", ms(encoded));
+        eprintln!("write      {:9.2} ms", ms(written));
         for (i, l) in info.layers.iter().enumerate() {
             eprintln!(
                 "layer {i}: level {}{}, {} quads, {} triangles drawn; refine {:.2} ms, evaluate {:.2} ms, tessellate {:.2} ms",
