@@ -116,7 +116,10 @@ use crate::mesh::{Document, GradientMesh};
 
 pub use folds::{find_folds, find_folds_at, Fold, FOLD_LEVEL};
 pub use gamut::{BlendSpace, GamutMapping};
-pub use output::{encode_png, encode_png_rgba16, encode_png_rgba8, Image, OutputPixel};
+pub use output::{
+    encode_png, encode_png_rgba16, encode_png_rgba8, write_png, write_png_rgba16, write_png_rgba8,
+    Image, OutputPixel,
+};
 pub use overlay::draw_outlines;
 pub use view::{document_bounds, View};
 
