@@ -249,8 +249,9 @@ pub fn encode_png_rgba16(width: u32, height: u32, data: &[u16]) -> Result<Vec<u8
     Ok(out)
 }
 
-/// [`encode_png`], written to `out` as it is encoded: the file is never held in memory (nor,
-/// for 16 bits, the image as bytes). The bytes are those [`encode_png`] returns.
+/// [`encode_png`], written to `out` as it is encoded, so that the caller holds no copy of the
+/// file (for 8 bits `png` keeps the compressed stream until the end; 16-bit rows are
+/// converted and compressed a band at a time). The bytes are those [`encode_png`] returns.
 pub fn write_png(out: impl Write, image: &Image, bits: u8, dither: bool) -> Result<(), Error> {
     match bits {
         8 => write_png_rgba8(out, image.width, image.height, &image.to_u8(dither)),
