@@ -301,7 +301,7 @@ pub fn write_png_rgba16(
                 }
             });
         rows.write_all(bytes)
-            .map_err(|e| Error::from(ErrorKind::Io(format!("PNG encoding: {e}"))))?;
+            .map_err(|e| png_error(png::EncodingError::from(e)))?;
     }
     rows.finish().map_err(png_error)?;
     writer.finish().map_err(png_error)
