@@ -165,6 +165,15 @@ impl Source {
         }
     }
 
+    /// [`Source::grid`] into `out`, whose memory a regular patch reuses.
+    fn grid_into(&mut self, n: usize, out: &mut Grid) -> Option<()> {
+        match self {
+            Source::Regular(cp) => super::patches::evaluate_patch_into(cp, n, out),
+            Source::Local { patch, root } => *out = patch.grid(*root, n)?,
+        }
+        Some(())
+    }
+
     /// Whether the convex hull of the points face `f`'s surface is made of misses the image:
     /// a patch's control points, or the points of the faces around it in `level`.
     fn off_image(
@@ -276,8 +285,8 @@ impl CellOrders {
     }
 }
 
-/// Measures a face's grid of `n` cells a side against its grid of `2 n` (whose even samples
-/// are the same points). `boundary[k]`: whether side `k` of the face lies on the outline.
+/// Measures a face's grid of `n` cells a side (every `step`-th point of `g`, row and column)
+/// against its grid of `2 n` (whose even samples are the same points). `boundary[k]`: whether side `k` of the face lies on the outline.
 /// `counted` receives, per cell, whether its colour counted (it reaches the image and is not
 /// too small to matter, see [`measure_quad`]); `jacobians`, in spaces whose distances are not
 /// Lab's, the derivative to Lab at each cell's centre (the points of the finer grid with both
@@ -285,6 +294,7 @@ impl CellOrders {
 #[allow(clippy::too_many_arguments)]
 fn measure_grid(
     g: &[VertexData],
+    step: usize,
     n: usize,
     g2: &[VertexData],
     cells: &[Cell],
@@ -294,8 +304,8 @@ fn measure_grid(
     counted: &mut Vec<bool>,
     jacobians: &mut Vec<Matrix3>,
 ) -> Measure {
-    let (s1, s2) = (n + 1, 2 * n + 1);
-    let at = |(i, j): (usize, usize)| &g[j * s1 + i];
+    let (s1, s2) = (step * (step * n + 1), 2 * n + 1);
+    let at = |(i, j): (usize, usize)| &g[j * s1 + i * step];
     // The point halfway between two grid points, from the finer grid.
     let mid = |a: (usize, usize), b: (usize, usize)| &g2[(a.1 + b.1) * s2 + a.0 + b.0];
     // Which face side, if any, both ends of a cell side lie on.
@@ -342,6 +352,18 @@ fn measure_grid(
     m
 }
 
+/// Buffers one thread's planning reuses from face to face (most faces of a dense layer stop at
+/// a cell or two a side, and each measure allocating its own cost a dense layer several
+/// allocations a face).
+#[derive(Default)]
+struct PlanScratch {
+    counted: Vec<bool>,
+    jacobians: Vec<Matrix3>,
+    side_nodes: Vec<Option<[f64; 4]>>,
+    /// The grid of `4 n` cells a side a quadratic measure reads.
+    quarter: Grid,
+}
+
 /// Whether colour errors in `space` are measured through the derivative to Lab.
 fn needs_jacobians(space: ColourSpace) -> bool {
     matches!(
@@ -362,6 +384,9 @@ enum Order {
 #[derive(Clone)]
 struct Plan {
     n: usize,
+    /// The grid of `n` cells a side; empty where it is the even points of `finer` (a regular
+    /// patch's grids share their points bit for bit), which saves a quadratic face an
+    /// allocation and a copy. Read through [`Plan::at`].
     grid: Grid,
     measured: Measure,
     capped: bool,
@@ -374,6 +399,24 @@ struct Plan {
     finer: Option<Grid>,
     /// A quadratic face's colour error with linear pieces, where measured at its count.
     linear_colour: Option<f64>,
+}
+
+impl Plan {
+    /// Point `(i, j)` of the face's grid of `n` cells a side.
+    fn at(&self, i: usize, j: usize) -> &VertexData {
+        match &self.finer {
+            Some(g2) if self.grid.is_empty() => &g2[2 * (j * (2 * self.n + 1) + i)],
+            _ => &self.grid[j * (self.n + 1) + i],
+        }
+    }
+
+    /// The grid of `n` cells a side, and the step between its points in the slice.
+    fn grid_view(&self) -> (&[VertexData], usize) {
+        match &self.finer {
+            Some(g2) if self.grid.is_empty() => (g2, 2),
+            _ => (&self.grid, 1),
+        }
+    }
 }
 
 /// The plans of a layer's faces at its last preparation, kept by a
@@ -539,17 +582,17 @@ pub(super) fn tessellate(
 
     // 1. The density of each face.
     let orders = CellOrders::new(n_max.max(1) * 2);
-    let plan_face = |f: usize, src: &mut Source| -> Option<Plan> {
+    let plan_face = |f: usize, src: &mut Source, scratch: &mut PlanScratch| -> Option<Plan> {
         let off_image = src.off_image(level, d, f, xf, th.size);
         // A regular patch's grid of two cells holds its grid of one (the same parameters and
-        // arithmetic): evaluate it once and take its corners. (Local refinement evaluates each
-        // depth on its own, so it keeps its order of evaluation.)
+        // arithmetic): evaluate it once and read its corners from it (the grid stays empty
+        // until the face is known to need it on its own). Local refinement evaluates each
+        // depth on its own, so it keeps its order of evaluation.
+        let regular_source = matches!(src, Source::Regular(_));
         let mut next = None;
-        let grid = if matches!(src, Source::Regular(_)) && !off_image && n_max > 1 {
-            let g2 = src.grid(2)?;
-            let g1 = [0, 2, 6, 8].map(|k| g2[k]).to_vec();
-            next = Some(g2);
-            g1
+        let grid = if regular_source && !off_image && n_max > 1 {
+            next = Some(src.grid(2)?);
+            Vec::new()
         } else {
             src.grid(1)?
         };
@@ -569,7 +612,6 @@ pub(super) fn tessellate(
         }
         let boundary = boundary_sides(f);
         let (mut last_colour, mut last_quadratic): (Option<f64>, Option<f64>) = (None, None);
-        let (mut counted, mut jacobians) = (Vec::new(), Vec::new());
         loop {
             if plan.n >= n_max {
                 plan.capped = true;
@@ -579,21 +621,31 @@ pub(super) fn tessellate(
                 Some(g) => g,
                 None => src.grid(2 * plan.n)?,
             };
+            // The grid of `n`: the plan's, or the even points of the finer one.
+            let (coarse, step) = if plan.grid.is_empty() {
+                (&finer[..], 2)
+            } else {
+                (&plan.grid[..], 1)
+            };
             let m = measure_grid(
-                &plan.grid,
+                coarse,
+                step,
                 plan.n,
                 &finer,
                 orders.get(plan.n),
                 boundary,
                 xf,
                 th,
-                &mut counted,
-                &mut jacobians,
+                &mut scratch.counted,
+                &mut scratch.jacobians,
             );
             if passes(&m) {
                 plan.measured = m;
                 if plan.n == 1 {
                     plan.centre = Some(finer[4]);
+                }
+                if plan.grid.is_empty() {
+                    plan.grid = even_points(&finer, plan.n);
                 }
                 return Some(plan);
             }
@@ -605,18 +657,19 @@ pub(super) fn tessellate(
             let mut quadratic = None;
             if th.quadratic
                 && m.colour <= QUADRATIC_MAX_LINEAR_ERROR * th.colour
-                && turn_flags(&plan.grid, plan.n) != 3
+                && turn_flags(coarse, step, plan.n) != 3
             {
-                let g4 = src.grid(4 * plan.n)?;
+                src.grid_into(4 * plan.n, &mut scratch.quarter)?;
                 let colour = measure_cells(
                     &finer,
-                    &g4,
+                    &scratch.quarter,
                     plan.n,
                     orders.get(plan.n),
-                    &counted,
+                    &scratch.counted,
                     xf,
                     th.space,
-                    needs_jacobians(th.space).then_some(&jacobians[..]),
+                    needs_jacobians(th.space).then_some(&scratch.jacobians[..]),
+                    &mut scratch.side_nodes,
                 );
                 let mq = Measure { colour, ..m };
                 if passes(&mq) {
@@ -630,7 +683,7 @@ pub(super) fn tessellate(
                     return Some(plan);
                 }
                 quadratic = Some(colour);
-                next = Some(g4);
+                next = Some(std::mem::take(&mut scratch.quarter));
             }
             // Size halves per level and the outline's distance quarters. The colour error of
             // linear pieces quarters where the colour is smooth, but may only halve next to an
@@ -665,10 +718,13 @@ pub(super) fn tessellate(
                     colour: ratio * colour,
                     ..predicted
                 };
-                if passes(&predicted) && turn_flags(&plan.grid, plan.n) != 3 {
+                if passes(&predicted) && turn_flags(&plan.grid, 1, plan.n) != 3 {
                     plan.measured = predicted;
                     plan.order = Order::Quadratic;
                     plan.finer = next.take();
+                    if regular_source && plan.finer.is_some() {
+                        plan.grid = Vec::new();
+                    }
                     return Some(plan);
                 }
             }
@@ -687,14 +743,14 @@ pub(super) fn tessellate(
         let (m, again) = (old_memo?, again.as_ref()?);
         (!again[f]).then(|| &m.faces[f])
     };
-    let planned: Vec<(Option<Arc<Plan>>, bool)> = each_face(nf, |f| {
+    let planned: Vec<(Option<Arc<Plan>>, bool)> = each_face_with(nf, |scratch, f| {
         if let Some(KeptPlan::Regular(plan)) = kept_plan(f) {
             return Some((Some(Arc::clone(plan)), true));
         }
         let Some(cp) = regular_patch_with(level, d, f, |v| regular[v]) else {
             return Some((None, false));
         };
-        let plan = plan_face(f, &mut Source::Regular(cp))?;
+        let plan = plan_face(f, &mut Source::Regular(cp), scratch)?;
         Some((Some(Arc::new(plan)), false))
     })?;
     // Which faces kept their plans.
@@ -723,11 +779,12 @@ pub(super) fn tessellate(
         }
     };
     let each_alone = |group: &[(usize, usize)]| -> Option<Planned> {
+        let mut scratch = PlanScratch::default();
         group
             .iter()
             .map(|&(_, f)| {
                 let mut src = Source::new(level, &regular, d, f, shapes)?;
-                let plan = plan_face(f, &mut src)?;
+                let plan = plan_face(f, &mut src, &mut scratch)?;
                 Some((f, Arc::new(plan), kept(src)?, 0))
             })
             .collect()
@@ -739,11 +796,12 @@ pub(super) fn tessellate(
             root: 0,
         };
         let mut planned = Vec::with_capacity(faces.len());
+        let mut scratch = PlanScratch::default();
         for (k, &f) in faces.iter().enumerate() {
             if let Source::Local { root, .. } = &mut src {
                 *root = k;
             }
-            planned.push((f, plan_face(f, &mut src)?));
+            planned.push((f, plan_face(f, &mut src, &mut scratch)?));
         }
         let patch = kept(src)?;
         Some(
@@ -848,7 +906,13 @@ pub(super) fn tessellate(
     // fold's crease runs, which no measure checks: faces whose cells do not all turn the same
     // way, and faces next to them or next to a face turned the other way, take the full count
     // of their finest edge (as uniform refinement would give them) instead of half.
-    let turns: Vec<u8> = plans.par_iter().map(|p| turn_flags(&p.grid, p.n)).collect();
+    let turns: Vec<u8> = plans
+        .par_iter()
+        .map(|p| {
+            let (g, step) = p.grid_view();
+            turn_flags(g, step, p.n)
+        })
+        .collect();
     let folded = |f: usize| -> bool {
         turns[f] == 3
             || t.face_edges(f).iter().any(|&e| {
@@ -874,7 +938,6 @@ pub(super) fn tessellate(
             };
             if n != plan.n {
                 let plan = Arc::make_mut(plan);
-                plan.grid = regrid(f, n)?;
                 // A quadratic face refined further for its neighbours' sake is often fine
                 // enough for linear pieces, which need no grid of twice the count for their
                 // nodes: predicted from the linear error at its own count, falling by no
@@ -884,16 +947,23 @@ pub(super) fn tessellate(
                     .linear_colour
                     .map(|c| c * LINEAR_RATE_NEAR_FOLDS.powi(levels))
                     .filter(|&c| c <= th.colour);
-                match (plan.order, linear) {
-                    (Order::Quadratic, Some(colour)) => {
-                        plan.order = Order::Linear;
-                        plan.finer = None;
-                        plan.measured.colour = colour;
-                        plan.estimated = true;
-                    }
-                    (Order::Quadratic, None) => plan.finer = Some(regrid(f, 2 * n)?),
-                    (Order::Linear, _) => {}
+                if let (Order::Quadratic, Some(colour)) = (plan.order, linear) {
+                    plan.order = Order::Linear;
+                    plan.measured.colour = colour;
+                    plan.estimated = true;
                 }
+                // A regular patch's quadratic face reads its grid from the finer one.
+                let quadratic = plan.order == Order::Quadratic;
+                plan.grid = if quadratic && local_of[f].is_none() {
+                    Vec::new()
+                } else {
+                    regrid(f, n)?
+                };
+                plan.finer = if quadratic {
+                    Some(regrid(f, 2 * n)?)
+                } else {
+                    None
+                };
                 plan.n = n;
             }
             Some(())
@@ -944,7 +1014,7 @@ pub(super) fn tessellate(
         let (m, ne) = (plan.n, edge_cells[e]);
         let q = if forward { s } else { ne - s };
         let (i, j) = side_position(k as usize, q * (m / ne), m);
-        &plan.grid[j * (m + 1) + i]
+        plan.at(i, j)
     };
     // Copied, unlike the edges': every face reads four, and one read here is one cache miss
     // instead of a chain of them.
@@ -958,7 +1028,7 @@ pub(super) fn tessellate(
             };
             let m = plans[f as usize].n;
             let (i, j) = side_position(c as usize, 0, m);
-            plans[f as usize].grid[j * (m + 1) + i]
+            *plans[f as usize].at(i, j)
         })
         .collect();
     let vertex_sample = |v: usize| &vertex_samples[v];
@@ -985,7 +1055,7 @@ pub(super) fn tessellate(
             None
         };
         match side {
-            None => &plans[f].grid[j * (m + 1) + i],
+            None => plans[f].at(i, j),
             Some((k, 0)) => vertex_sample(t.face_vertices(f)[k] as usize),
             Some((k, q)) if q == m => vertex_sample(t.face_vertices(f)[(k + 1) % 4] as usize),
             Some((k, q)) => {
@@ -1340,16 +1410,38 @@ fn each_face<T: Send>(nf: usize, f: impl Fn(usize) -> Option<T> + Sync + Send) -
     all.into_iter().collect()
 }
 
+/// [`each_face`] with a [`PlanScratch`] per piece of the work.
+fn each_face_with<T: Send>(
+    nf: usize,
+    f: impl Fn(&mut PlanScratch, usize) -> Option<T> + Sync + Send,
+) -> Option<Vec<T>> {
+    let mut all: Vec<Option<T>> = Vec::with_capacity(nf);
+    (0..nf)
+        .into_par_iter()
+        .map_init(PlanScratch::default, f)
+        .collect_into_vec(&mut all);
+    all.into_iter().collect()
+}
+
+/// The grid of `n` cells a side among the points of the grid of `2 n`.
+fn even_points(g2: &[VertexData], n: usize) -> Grid {
+    let s2 = 2 * n + 1;
+    (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| g2[2 * (j * s2 + i)]))
+        .collect()
+}
+
 /// Which ways the cells of a grid of `n` cells a side turn in the plane: bit 0 for
-/// counter-clockwise, bit 1 for clockwise (3: the face folds over itself).
-fn turn_flags(g: &[VertexData], n: usize) -> u8 {
-    let s = n + 1;
+/// counter-clockwise, bit 1 for clockwise (3: the face folds over itself). The grid's points
+/// are every `step`-th of `g`'s, row and column.
+fn turn_flags(g: &[VertexData], step: usize, n: usize) -> u8 {
+    let s = step * (step * n + 1);
     let mut flags = 0;
     for j in 0..n {
         for i in 0..n {
             let [a, b, c, d] = each4(|k| {
                 let (x, y) = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)][k];
-                &g[y * s + x]
+                &g[y * s + x * step]
             });
             // Twice the signed area of the quad: the cross product of its diagonals.
             let cross = (c[0] - a[0]) * (d[1] - b[1]) - (c[1] - a[1]) * (d[0] - b[0]);

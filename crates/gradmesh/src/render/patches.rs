@@ -76,6 +76,13 @@ pub(crate) fn evaluate_patch(cp: &ControlGrid, n: usize) -> Grid {
     out
 }
 
+/// [`evaluate_patch`] into `out` (cleared first), reusing its memory.
+pub(crate) fn evaluate_patch_into(cp: &ControlGrid, n: usize, out: &mut Grid) {
+    out.clear();
+    out.reserve((n + 1) * (n + 1));
+    evaluate_patch_with(cp, n, |_, _, p| out.push(p));
+}
+
 /// Calls `put(i, j, p)` with the patch of `cp` at parameter `(i / n, j / n)`, row by row.
 fn evaluate_patch_with(cp: &ControlGrid, n: usize, mut put: impl FnMut(usize, usize, VertexData)) {
     // Most faces stop at a few cells: their basis values stay on the stack.

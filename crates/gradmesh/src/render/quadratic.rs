@@ -174,6 +174,7 @@ pub(super) fn measure_cells(
     xf: &ToPixels,
     space: ColourSpace,
     jacobians: Option<&[Matrix3]>,
+    side_nodes: &mut Vec<Option<[f64; 4]>>,
 ) -> f64 {
     let (s2, s4) = (2 * n + 1, 4 * n + 1);
     let at2 = |(i, j): (usize, usize)| &g2[j * s2 + i];
@@ -187,7 +188,8 @@ pub(super) fn measure_cells(
     };
     // The nodes of the cells' sides, each found once (a side is shared by two cells): at
     // points of the finer grid with one odd coordinate, wanted where a counted cell is.
-    let mut side_nodes: Vec<Option<[f64; 4]>> = vec![None; s2 * s2];
+    side_nodes.clear();
+    side_nodes.resize(s2 * s2, None);
     let mut worst = 0.0f64;
     for (cell, _) in cells.iter().zip(counted).filter(|(_, &c)| c) {
         let corner = |k: usize| at2((2 * cell[k].0, 2 * cell[k].1));
