@@ -286,11 +286,12 @@ impl CellOrders {
 }
 
 /// Measures a face's grid of `n` cells a side (every `step`-th point of `g`, row and column)
-/// against its grid of `2 n` (whose even samples are the same points). `boundary[k]`: whether side `k` of the face lies on the outline.
-/// `counted` receives, per cell, whether its colour counted (it reaches the image and is not
-/// too small to matter, see [`measure_quad`]); `jacobians`, in spaces whose distances are not
-/// Lab's, the derivative to Lab at each cell's centre (the points of the finer grid with both
-/// coordinates odd; the others are never asked for), which the quadratic measure reads too.
+/// against its grid of `2 n` (whose even samples are the same points). `boundary[k]`: whether
+/// side `k` of the face lies on the outline. `counted` receives, per cell, whether its colour
+/// counted (it reaches the image and is not too small to matter, see [`measure_quad`]);
+/// `jacobians`, in spaces whose distances are not Lab's, the derivative to Lab at each cell's
+/// centre (the points of the finer grid with both coordinates odd; the others are never asked
+/// for), which the quadratic measure reads too.
 #[allow(clippy::too_many_arguments)]
 fn measure_grid(
     g: &[VertexData],
@@ -404,10 +405,8 @@ struct Plan {
 impl Plan {
     /// Point `(i, j)` of the face's grid of `n` cells a side.
     fn at(&self, i: usize, j: usize) -> &VertexData {
-        match &self.finer {
-            Some(g2) if self.grid.is_empty() => &g2[2 * (j * (2 * self.n + 1) + i)],
-            _ => &self.grid[j * (self.n + 1) + i],
-        }
+        let (g, step) = self.grid_view();
+        &g[step * (j * (step * self.n + 1) + i)]
     }
 
     /// The grid of `n` cells a side, and the step between its points in the slice.
