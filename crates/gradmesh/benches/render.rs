@@ -2,7 +2,8 @@
 //! side, and the floor: filling the same RGBA `f32` buffer with one colour. Then the authors'
 //! six-layer Tucan at 1024 pixels wide into an 8-bit buffer, from scratch and as an editor
 //! re-renders it after one layer changed (`RenderCache`); Glasses at 1024 and both at 4096
-//! pixels wide, and the three Paprika layers at 1024 (`artwork`).
+//! pixels wide, and the three Paprika layers at 1024 (`artwork`). Last, time against mesh
+//! size: jittered grids of 10 to 10,000 faces at 1024x1024 (`mesh_size_1024`).
 //!
 //! Run: `cargo bench -p gradmesh --bench render` (add a name to run one example, e.g.
 //! `-- rectangle`, `-- tucan_1024` for the editing figures, `-- artwork` for the others).
@@ -15,7 +16,8 @@ use std::time::Duration;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use gradmesh::formats;
 use gradmesh::render::{
-    render_document, render_document_into, render_document_into_cached, RenderCache, RenderOptions,
+    render_document, render_document_into, render_document_into_cached, GamutMapping, RenderCache,
+    RenderOptions,
 };
 use gradmesh::Document;
 
@@ -155,5 +157,32 @@ fn bench_editing(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench, bench_editing, bench_artwork);
+/// Time against mesh size at a fixed pixel count: the scaling example's grids of 10 to 10,000
+/// faces at 1024x1024, as it renders them, and again with gamut clipping (their colours leave
+/// sRGB over about half the image, and the chroma search is the larger part of drawing them).
+fn bench_mesh_size(c: &mut Criterion) {
+    let mut g = c.benchmark_group("mesh_size_1024");
+    g.sample_size(10).measurement_time(Duration::from_secs(5));
+    for (w, h) in common::jittered_grid::SIZES {
+        let doc = common::jittered_grid::grid(w, h);
+        let mut opts = RenderOptions::fit(&doc, SIZE);
+        let faces = w * h;
+        g.bench_function(format!("{faces}_faces"), |b| {
+            b.iter(|| render_document(black_box(&doc), &opts).unwrap())
+        });
+        opts.gamut = GamutMapping::Clip;
+        g.bench_function(format!("{faces}_faces_clip"), |b| {
+            b.iter(|| render_document(black_box(&doc), &opts).unwrap())
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    bench,
+    bench_editing,
+    bench_artwork,
+    bench_mesh_size
+);
 criterion_main!(benches);

@@ -13,40 +13,11 @@ use std::time::Instant;
 
 use gradmesh::formats;
 use gradmesh::render::{render_document, RenderOptions};
-use gradmesh::{ColourSpace, Document, GradientMesh};
-use kurbo::Point;
+use gradmesh::Document;
 
-/// A jittered grid of `w` x `h` quads over a 1000-unit square, with smoothly varying colours.
-fn grid(w: u32, h: u32) -> Document {
-    let mut m = GradientMesh::new(ColourSpace::Lab);
-    for j in 0..=h {
-        for i in 0..=w {
-            let (u, v) = (i as f64 / w as f64, j as f64 / h as f64);
-            // Jitter inner points by up to a fifth of a cell, deterministically.
-            let inner = i > 0 && i < w && j > 0 && j < h;
-            let jitter = if inner { 0.2 } else { 0.0 };
-            let (dx, dy) = (
-                jitter * ((i * 7 + j * 13) % 11) as f64 / 10.0 - jitter / 2.0,
-                jitter * ((i * 5 + j * 3) % 7) as f64 / 6.0 - jitter / 2.0,
-            );
-            m.add_point(
-                Point::new(1000.0 * (u + dx / w as f64), 1000.0 * (v + dy / h as f64)),
-                [
-                    40.0 + 50.0 * u,
-                    60.0 * (6.0 * v).sin(),
-                    60.0 * (5.0 * u + 1.0).cos(),
-                ],
-            );
-        }
-    }
-    for j in 0..h {
-        for i in 0..w {
-            let a = j * (w + 1) + i;
-            m.add_face(vec![a, a + 1, a + w + 2, a + w + 1]);
-        }
-    }
-    Document { layers: vec![m] }
-}
+#[path = "../benches/common/jittered_grid.rs"]
+mod jittered_grid;
+use jittered_grid::grid;
 
 /// The median time of `runs` renders, in milliseconds.
 fn median_ms(doc: &Document, opts: &RenderOptions, runs: usize) -> Result<f64, Box<dyn Error>> {
@@ -76,7 +47,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         let (w, h) = (opts.width, opts.height);
         println!("pixels,{faces},{w},{h},{},{ms:.3}", w as u64 * h as u64);
     }
-    for (w, h) in [(5, 2), (10, 10), (40, 25), (100, 100)] {
+    for (w, h) in jittered_grid::SIZES {
         let doc = grid(w, h);
         let opts = RenderOptions::fit(&doc, 1024);
         let ms = median_ms(&doc, &opts, runs)?;

@@ -3,6 +3,7 @@
 // Each bench uses part of this.
 #![allow(dead_code)]
 
+pub mod jittered_grid;
 pub mod wavy_grid;
 
 use gradmesh::render::{
