@@ -6,7 +6,8 @@
 //! size: jittered grids of 10 to 10,000 faces at 1024x1024 (`mesh_size_1024`).
 //!
 //! Run: `cargo bench -p gradmesh --bench render` (add a name to run one example, e.g.
-//! `-- rectangle`, `-- tucan_1024` for the editing figures, `-- artwork` for the others).
+//! `-- rectangle`, `-- tucan_1024` for the editing figures, `-- artwork` for the others,
+//! `-- mesh_size` for the grids).
 
 #![allow(missing_docs)] // criterion_group! generates undocumented items.
 
