@@ -6,6 +6,8 @@
 //! edge quads. Level-1 vertices are numbered: one vertex point per base vertex, two edge points
 //! per base edge (the one near `edge_vertices(e)[0]` first), one face point per base corner.
 
+use std::ops::Range;
+
 use kurbo::{Point, Vec2};
 
 use crate::catmull_clark::Level;
@@ -313,18 +315,35 @@ pub fn ternary_topology(t: &Topology) -> Topology {
 /// `D1` is the handle along the edge to the next corner `V1`, `D2` along the edge to the
 /// previous corner `V2`, and `C` the centroid of the face.
 pub fn face_point_position(v0: Point, v1: Point, v2: Point, d1: Vec2, d2: Vec2, c: Point) -> Point {
+    let (w1, w2) = (handle_weight(d1, v1 - v0), handle_weight(d2, v2 - v0));
+    face_point_from_weights(v0, d1, d2, w1, w2, c)
+}
+
+/// `d = 2 |D| / |edge|` of [`face_point_position`]: a handle's length relative to half its
+/// edge's. The same for either direction of `edge` (a length only sees magnitudes).
+fn handle_weight(handle: Vec2, edge: Vec2) -> f64 {
     // f64::hypot, not Vec2::hypot: no overflow or underflow at extreme scales.
     let length = |v: Vec2| v.x.hypot(v.y);
-    let w1 = 2.0 * length(d1) / length(v1 - v0);
-    let w2 = 2.0 * length(d2) / length(v2 - v0);
+    2.0 * length(handle) / length(edge)
+}
+
+/// [`face_point_position`] from the weights of its two handles.
+fn face_point_from_weights(v0: Point, d1: Vec2, d2: Vec2, w1: f64, w2: f64, c: Point) -> Point {
     v0 + d1 * (1.0 - w2) + d2 * (1.0 - w1) + (c - v0) * (w1 * w2)
 }
 
 /// The level-1 data of `base`: positions from the handles, colours copied from the control
 /// point each new point surrounds.
 pub fn ternary_data(base: &BaseMesh) -> Vec<VertexData> {
+    ternary_data_on(base, base.topology.corner_count() >= PARALLEL_MIN_CORNERS)
+}
+
+/// [`ternary_data`], computed concurrently if `parallel` (each point by the same arithmetic
+/// either way).
+fn ternary_data_on(base: &BaseMesh, parallel: bool) -> Vec<VertexData> {
     let t = &base.topology;
-    let mut out = vec![[0.0; 6]; t.vertex_count() + 2 * t.edge_count() + t.corner_count()];
+    let (nv, ne) = (t.vertex_count(), t.edge_count());
+    let mut out = vec![[0.0; 6]; nv + 2 * ne + t.corner_count()];
     let pos = |v: u32| {
         let d = &base.data[v as usize];
         Point::new(d[0], d[1])
@@ -335,35 +354,89 @@ pub fn ternary_data(base: &BaseMesh) -> Vec<VertexData> {
         d[1] = p.y;
         d
     };
-    out[..t.vertex_count()].copy_from_slice(&base.data);
-    for e in 0..t.edge_count() {
-        let ends = t.edge_vertices(e);
-        for (end, &v) in ends.iter().enumerate() {
-            let h = base.edge_handles[e][end];
-            out[edge_point(t, e as u32, end) as usize] = with_position(v, pos(v) + h);
+    let (vertex_points, rest) = out.split_at_mut(nv);
+    let (edge_points, face_points) = rest.split_at_mut(2 * ne);
+    vertex_points.copy_from_slice(&base.data);
+    // Per edge end: the edge point, and the weight of its handle (each edge's lengths are
+    // taken once here rather than at each of the up to four corners that read them).
+    let mut weights = vec![[0.0; 2]; ne];
+    let edges = |first: usize, points: &mut [VertexData], weights: &mut [[f64; 2]]| {
+        for (k, (pair, w)) in points.chunks_exact_mut(2).zip(weights).enumerate() {
+            let e = first + k;
+            let [a, b] = t.edge_vertices(e);
+            let edge = pos(b) - pos(a);
+            for (end, v) in [a, b].into_iter().enumerate() {
+                let h = base.edge_handles[e][end];
+                pair[end] = with_position(v, pos(v) + h);
+                w[end] = handle_weight(h, edge);
+            }
         }
+    };
+    if parallel {
+        use rayon::prelude::*;
+        const EDGES: usize = 1 << 11;
+        edge_points
+            .par_chunks_mut(2 * EDGES)
+            .zip(weights.par_chunks_mut(EDGES))
+            .enumerate()
+            .for_each(|(i, (points, w))| edges(i * EDGES, points, w));
+    } else {
+        edges(0, edge_points, &mut weights);
     }
+    let weight = |e: u32, v: u32| weights[e as usize][end_of(t, e, v)];
     let handle = |e: u32, v: u32| base.edge_handles[e as usize][end_of(t, e, v)];
-    for f in 0..t.face_count() {
-        let fv = t.face_vertices(f);
-        let fe = t.face_edges(f);
-        let n = fv.len();
-        let centroid = fv.iter().fold(Vec2::ZERO, |acc, &v| acc + pos(v).to_vec2()) / n as f64;
-        let c = centroid.to_point();
-        for i in 0..n {
-            let (next, prev) = ((i + 1) % n, (i + n - 1) % n);
-            let p = face_point_position(
-                pos(fv[i]),
-                pos(fv[next]),
-                pos(fv[prev]),
-                handle(fe[i], fv[i]),
-                handle(fe[prev], fv[i]),
-                c,
-            );
-            out[face_point(t, t.face_offset(f) + i) as usize] = with_position(fv[i], p);
+    // Face points of faces `faces`, whose corners are `points` (face points are numbered
+    // in corner order).
+    let face_points_of = |faces: Range<usize>, points: &mut [VertexData]| {
+        let first = t.face_offset(faces.start);
+        for f in faces {
+            let fv = t.face_vertices(f);
+            let fe = t.face_edges(f);
+            let n = fv.len();
+            let centroid = fv.iter().fold(Vec2::ZERO, |acc, &v| acc + pos(v).to_vec2()) / n as f64;
+            let c = centroid.to_point();
+            let at = t.face_offset(f) - first;
+            for i in 0..n {
+                let prev = (i + n - 1) % n;
+                let (v0, eo, ei) = (fv[i], fe[i], fe[prev]);
+                let p = face_point_from_weights(
+                    pos(v0),
+                    handle(eo, v0),
+                    handle(ei, v0),
+                    weight(eo, v0),
+                    weight(ei, v0),
+                    c,
+                );
+                points[at + i] = with_position(v0, p);
+            }
         }
+    };
+    if parallel {
+        split_faces(t, 0..t.face_count(), face_points, &face_points_of);
+    } else {
+        face_points_of(0..t.face_count(), face_points);
     }
     out
+}
+
+/// Calls `each(faces, corners)` on runs of faces that together cover `faces`, concurrently,
+/// with `corners` the part of `slots` (one per corner of `faces`) that belongs to the run.
+fn split_faces<T: Send>(
+    t: &Topology,
+    faces: Range<usize>,
+    slots: &mut [T],
+    each: &(impl Fn(Range<usize>, &mut [T]) + Sync),
+) {
+    const FACES: usize = 1 << 10;
+    if faces.len() <= FACES {
+        return each(faces, slots);
+    }
+    let middle = faces.start + faces.len() / 2;
+    let (left, right) = slots.split_at_mut(t.face_offset(middle) - t.face_offset(faces.start));
+    rayon::join(
+        || split_faces(t, faces.start..middle, left, each),
+        || split_faces(t, middle..faces.end, right, each),
+    );
 }
 
 #[cfg(test)]
@@ -406,6 +479,72 @@ mod tests {
         let child = ternary_topology(&t);
         child.assert_matches_a_rebuild();
         assert_eq!(child.euler_characteristic(), t.euler_characteristic());
+    }
+
+    /// Every point of a mesh large enough to be computed concurrently: the same bits on one
+    /// thread and on several, and the face points those of [`face_point_position`].
+    #[test]
+    fn concurrent_data_matches_the_formulas() {
+        use crate::{ColourSpace, GradientMesh};
+        let n = 40;
+        let mut m = GradientMesh::new(ColourSpace::Lab);
+        for j in 0..=n {
+            for i in 0..=n {
+                let jitter = f64::from((i * 7 + j * 13) % 10) * 0.03;
+                m.add_point(
+                    Point::new(f64::from(i) + jitter, f64::from(j) - jitter),
+                    [f64::from(i), f64::from(j), 0.0],
+                );
+            }
+        }
+        for j in 0..n {
+            for i in 0..n {
+                let v = j * (n + 1) + i;
+                if (i + j) % 3 == 0 {
+                    m.add_face(vec![v, v + 1, v + n + 2]);
+                    m.add_face(vec![v, v + n + 2, v + n + 1]);
+                } else {
+                    m.add_face(vec![v, v + 1, v + n + 2, v + n + 1]);
+                }
+                // Handles of every length along the bottom edges, both ways.
+                let scale = 0.05 + f64::from((i * 5 + j) % 9) * 0.05;
+                m.set_handle(v, v + 1, Vec2::new(scale, 0.01));
+                m.set_handle(v + 1, v, Vec2::new(-0.4 * scale, 0.0));
+            }
+        }
+        let (base, _) = BaseMesh::new(&m).unwrap();
+        let t = &base.topology;
+        assert!(t.corner_count() >= PARALLEL_MIN_CORNERS);
+        let (one, many) = (ternary_data_on(&base, false), ternary_data_on(&base, true));
+        let bits = |d: &[VertexData]| d.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&one), bits(&many));
+        assert_eq!(ternary_data(&base), many);
+
+        let pos = |v: u32| Point::new(base.data[v as usize][0], base.data[v as usize][1]);
+        let handle = |e: u32, v: u32| base.edge_handles[e as usize][end_of(t, e, v)];
+        for f in 0..t.face_count() {
+            let (fv, fe) = (t.face_vertices(f), t.face_edges(f));
+            let k = fv.len();
+            let c =
+                (fv.iter().fold(Vec2::ZERO, |a, &v| a + pos(v).to_vec2()) / k as f64).to_point();
+            for i in 0..k {
+                let (next, prev) = ((i + 1) % k, (i + k - 1) % k);
+                let p = face_point_position(
+                    pos(fv[i]),
+                    pos(fv[next]),
+                    pos(fv[prev]),
+                    handle(fe[i], fv[i]),
+                    handle(fe[prev], fv[i]),
+                    c,
+                );
+                let d = many[face_point(t, t.face_offset(f) + i) as usize];
+                assert_eq!(
+                    [d[0].to_bits(), d[1].to_bits()],
+                    [p.x.to_bits(), p.y.to_bits()]
+                );
+                assert_eq!(d[2..], base.data[fv[i] as usize][2..]);
+            }
+        }
     }
 
     #[test]
