@@ -1,5 +1,6 @@
-//! Benchmarks of the refinement stages: validation and base level, the ternary step, a
-//! Catmull-Clark step (topology and stencils), data evaluation, and limit stencils.
+//! Benchmarks of the refinement stages: validation and base level, the ternary step (topology,
+//! data, and the two with validation), a Catmull-Clark step (topology and stencils), data
+//! evaluation, and limit stencils.
 //!
 //! Run: `cargo bench -p gradmesh --bench refine`.
 
@@ -36,6 +37,14 @@ fn bench(c: &mut Criterion) {
     });
     g.bench_function("ternary_step_and_setup", |b| {
         b.iter(|| Refinement::new(black_box(&m), 1).unwrap())
+    });
+    // The whole first step as a user gets it: validation, level-1 topology and its data.
+    g.bench_function("ternary_step_setup_and_data", |b| {
+        b.iter(|| {
+            let (r, _) = Refinement::new(black_box(&m), 1).unwrap();
+            let data = r.evaluate();
+            (r, data)
+        })
     });
     g.bench_function("catmull_clark_topology_and_stencils", |b| {
         b.iter(|| catmull_clark::refine(black_box(&level1)))
