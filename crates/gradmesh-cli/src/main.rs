@@ -13,9 +13,10 @@ fn main() -> ExitCode {
     let cli = args::Cli::parse();
     match commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
+        Err(commands::Failure::Error(e)) => {
             eprintln!("gradmesh: error: {e}");
             ExitCode::FAILURE
         }
+        Err(commands::Failure::Reported) => ExitCode::FAILURE,
     }
 }

@@ -488,3 +488,276 @@ fn render_writes_the_image_paths_pixels() {
     assert!(std::fs::read(&out).unwrap() == expect);
     assert!(expect != encode_png(&image, 8, true).unwrap());
 }
+
+/// An absurd request: the command fails with exit status 1 (as every refused limit does) and
+/// one line of error on standard error, without aborting, in well under a second of work, and
+/// leaves an existing output file as it was.
+fn assert_refused(args: &[&str], output: Option<&Path>, expected: &[&str]) {
+    if let Some(out) = output {
+        std::fs::write(out, "precious").unwrap();
+    }
+    let o = gradmesh(args);
+    let msg = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{args:?}: {msg}");
+    let errors: Vec<&str> = msg
+        .lines()
+        .filter(|l| !l.starts_with("gradmesh: warning:"))
+        .collect();
+    assert_eq!(errors.len(), 1, "{args:?}: one line of error, got {msg}");
+    assert!(
+        errors[0].starts_with("gradmesh: error: "),
+        "{args:?}: {msg}"
+    );
+    for e in expected {
+        assert!(errors[0].contains(e), "{args:?}: {e:?} not in {msg}");
+    }
+    if let Some(out) = output {
+        assert_eq!(
+            std::fs::read_to_string(out).unwrap(),
+            "precious",
+            "{args:?}"
+        );
+        let dir = out.parent().unwrap();
+        let tmp = std::fs::read_dir(dir)
+            .unwrap()
+            .filter(|e| {
+                e.as_ref()
+                    .unwrap()
+                    .file_name()
+                    .to_string_lossy()
+                    .contains(".tmp")
+            })
+            .count();
+        assert_eq!(
+            tmp,
+            0,
+            "{args:?}: a temporary file was left in {}",
+            dir.display()
+        );
+    }
+}
+
+#[test]
+fn absurd_images_are_refused_before_anything_is_allocated() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.png");
+    let input = realdata().join("Glasses.off");
+    let render = |extra: &[&str], expected: &[&str]| {
+        let mut args = vec!["render", s(&input), "-o", s(&out)];
+        args.extend_from_slice(extra);
+        assert_refused(&args, Some(&out), expected);
+    };
+    // 10^12 pixels: the pixel count and the limit are named.
+    render(
+        &["--width", "1000000", "--height", "1000000"],
+        &["pixel count is 1,000,000,000,000", "limit of 100,000,000"],
+    );
+    // A side of 2^31, alone and with the pixel limit lifted.
+    render(&["--width", "2147483648"], &["pixel count"]);
+    render(
+        &[
+            "--width",
+            "2147483648",
+            "--height",
+            "1",
+            "--max-pixels",
+            "18446744073709551615",
+        ],
+        &["image side is 2,147,483,648", "limit of 32,768"],
+    );
+    // 40 levels.
+    render(
+        &["--width", "100", "--level", "40"],
+        &[
+            "Glasses.off: layer 0: the number of quads of refinement level 40",
+            "limit of 2,097,152",
+        ],
+    );
+    // A level within max_level whose quads would exceed max_quads is refused from an estimate.
+    render(
+        &["--width", "100", "--level", "9"],
+        &[
+            "Glasses.off: layer 0: the number of quads of refinement level 9",
+            "limit of 2,097,152",
+        ],
+    );
+    // Views 1e300 and 1e-300 wide.
+    render(
+        &["--width", "100", "--view", "0", "0", "1e300", "1e300"],
+        &["view: (0.0, 0.0) to (1e300, 1e300)", "beyond ±1e150"],
+    );
+    render(
+        &["--width", "100", "--view", "0", "0", "1e-300", "1e-300"],
+        &[
+            "view: (0.0, 0.0) to (1e-300, 1e-300)",
+            "a pixel would be 1e-302 units across",
+        ],
+    );
+    // A view far from the origin whose pixels its coordinates cannot resolve.
+    render(
+        &[
+            "--width",
+            "100",
+            "--view",
+            "1e12",
+            "0",
+            "1.000000000001e12",
+            "1",
+        ],
+        &["a pixel would be"],
+    );
+    // 16 bits at the pixel limit: one pixel more than allowed is refused, as at 8 bits.
+    render(
+        &["--width", "10001", "--height", "10000", "--bits", "16"],
+        &["pixel count is 100,010,000", "limit of 100,000,000"],
+    );
+    render(
+        &[
+            "--width",
+            "41",
+            "--height",
+            "100",
+            "--bits",
+            "16",
+            "--max-pixels",
+            "4000",
+        ],
+        &["pixel count is 4,100", "limit of 4,000"],
+    );
+    render(
+        &[
+            "--width",
+            "41",
+            "--height",
+            "100",
+            "--boundary",
+            "--max-pixels",
+            "4000",
+        ],
+        &["pixel count is 4,100", "limit of 4,000"],
+    );
+    // At the limit it renders.
+    let o = gradmesh(&[
+        "render",
+        s(&input),
+        "-o",
+        s(&out),
+        "--width",
+        "40",
+        "--height",
+        "100",
+        "--bits",
+        "16",
+        "--max-pixels",
+        "4000",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_ne!(std::fs::read(&out).unwrap(), b"precious");
+}
+
+#[test]
+fn absurd_inputs_are_refused_by_every_command() {
+    let dir = tempfile::tempdir().unwrap();
+    // 2^31 declared faces (and, with the face limit lifted, a file too short for them).
+    let faces = dir.path().join("faces.off");
+    std::fs::write(&faces, "OFF\n3 2147483648 0\n0 0 0 50 0 0 0\n").unwrap();
+    // An edit at level 40.
+    let deep = dir.path().join("deep.json");
+    let mut doc: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../examples/multires.json"
+        ))
+        .unwrap(),
+    )
+    .unwrap();
+    doc["layers"][0]["edits"] = serde_json::json!([
+        {"level": 40, "face": 5, "point": 8, "at": [1, 1], "opacity": 0.5}
+    ]);
+    std::fs::write(&deep, doc.to_string()).unwrap();
+    let out_json = dir.path().join("out.json");
+    let out_obj = dir.path().join("out.obj");
+    let out_png = dir.path().join("out.png");
+    for (input, expected) in [
+        (
+            &faces,
+            vec![
+                "faces.off:2: the number of faces is 2,147,483,648",
+                "limit of 16,777,216",
+            ],
+        ),
+        (
+            &deep,
+            vec!["deep.json: layer 0: edit 0: expected a level in 1..=8, found 40"],
+        ),
+    ] {
+        let input = s(input);
+        assert_refused(&["info", input], None, &expected);
+        assert_refused(&["edits", input], None, &expected);
+        assert_refused(
+            &["convert", input, "-o", s(&out_json)],
+            Some(&out_json),
+            &expected,
+        );
+        assert_refused(
+            &["refine", input, "-o", s(&out_obj)],
+            Some(&out_obj),
+            &expected,
+        );
+        assert_refused(
+            &["render", input, "-o", s(&out_png)],
+            Some(&out_png),
+            &expected,
+        );
+    }
+    let lifted = ["--max-faces", "4294967296"];
+    let short = ["faces.off:3: unexpected end of file: expected the line of vertex 1"];
+    let f = s(&faces);
+    assert_refused(&[&["info", f][..], &lifted].concat(), None, &short);
+    assert_refused(
+        &[&["render", f, "-o", s(&out_png)][..], &lifted].concat(),
+        Some(&out_png),
+        &short,
+    );
+    // 40 levels of refinement.
+    let glasses = realdata().join("Glasses.off");
+    assert_refused(
+        &["refine", s(&glasses), "-o", s(&out_obj), "--levels", "40"],
+        Some(&out_obj),
+        &["Glasses.off: layer 0: the refinement level is 40, above the limit of 12"],
+    );
+    assert_refused(
+        &[
+            "refine",
+            s(&glasses),
+            "-o",
+            s(&out_obj),
+            "--levels",
+            "40",
+            "--max-level",
+            "100",
+        ],
+        Some(&out_obj),
+        &[
+            "the number of faces of refinement level",
+            "limit of 8,388,608",
+        ],
+    );
+}
+
+#[test]
+fn info_reports_each_unreadable_file_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = dir.path().join("a.json");
+    let b = dir.path().join("b.json");
+    std::fs::write(&a, "{").unwrap();
+    std::fs::write(&b, "[]").unwrap();
+    let o = gradmesh(&["info", s(&a), s(&b)]);
+    assert_eq!(o.status.code(), Some(1));
+    let msg = stderr(&o);
+    assert_eq!(msg.lines().count(), 2, "{msg}");
+    assert_eq!(msg.matches("a.json").count(), 1, "{msg}");
+    assert_eq!(msg.matches("b.json").count(), 1, "{msg}");
+    let o = gradmesh(&["info", s(&a)]);
+    assert_eq!(stderr(&o).lines().count(), 1, "{}", stderr(&o));
+}

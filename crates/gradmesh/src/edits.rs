@@ -35,6 +35,9 @@
 //!   construction the ternary step makes around each control point, so the target is the limit
 //!   colour at that vertex exactly, and every colour stays inside the hull of the colours in
 //!   play. A ring point shared by several edited vertices takes the mean of their targets.
+//!   An edit on a control point's own vertex or next to it (sector coordinates both at most 1)
+//!   therefore changes that control point's limit colour: the paper's Condition 1 then holds
+//!   at the edit, not at the point.
 //! - **Position** is an offset in the vertex's local frame: `offset[0]` times the sector grid's
 //!   edge from the vertex in direction `i`, plus `offset[1]` times its edge in direction `j`
 //!   (the edges of level `k`, before this level's edits). Subdivision commutes with affine

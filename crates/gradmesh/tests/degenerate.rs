@@ -297,9 +297,8 @@ fn a_view_inside_a_face_is_covered() {
     );
 }
 
-/// A point used by no face is legal (a warning). Its vertex at level 2 and below is NaN: the
-/// Catmull-Clark vertex rule divides by its valence, 0. Reported as a core bug; the fuzz
-/// entry points skip such vertices until it is fixed.
+/// A point used by no face is legal (a warning): it has no ring, so every level keeps it where
+/// it is, with its colour (the Catmull-Clark vertex rule would divide by its valence, 0).
 #[test]
 fn isolated_points_stay_finite() {
     let mut mesh = sample();

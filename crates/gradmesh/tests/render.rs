@@ -418,6 +418,8 @@ fn reference_is_converged() {
         opts.reference = true;
         let (a, info) = render_image(&d, &opts).unwrap();
         opts.level = Some(info.layers[0].level + 1);
+        // The level above reference mode's may hold more quads than the default cap allows.
+        opts.max_quads = 1 << 24;
         let b = render_document(&d, &opts).unwrap();
         let (qa, qb) = (a.to_u16(), b.to_u16());
         let mut worst = 0;

@@ -7,10 +7,13 @@ use gradmesh::topology::Topology;
 use gradmesh::validate::BaseMesh;
 use gradmesh::{EdgeKind, Error, GradientMesh};
 
+use super::Failure;
 use crate::args::InfoArgs;
 
-pub fn run(args: &InfoArgs) -> Result<(), Error> {
-    let mut failed = None;
+/// Describes every file, reporting each error as it comes; fails with the count of failures
+/// (each already printed) if any file or layer could not be described.
+pub fn run(args: &InfoArgs) -> Result<(), Failure> {
+    let mut failed = 0usize;
     let limits = args.limits.limits();
     for path in &args.inputs {
         match super::read(path, &limits) {
@@ -27,22 +30,21 @@ pub fn run(args: &InfoArgs) -> Result<(), Error> {
                         Err(e) => {
                             let e = e.in_layer(i).in_file(path);
                             eprintln!("gradmesh: error: {e}");
-                            failed = Some(e);
+                            failed += 1;
                         }
                     }
                 }
             }
             Err(e) => {
                 eprintln!("gradmesh: error: {e}");
-                failed = Some(e);
+                failed += 1;
             }
         }
     }
-    // Every file was reported; fail if any could not be read.
-    match failed {
-        Some(e) => Err(e),
-        None => Ok(()),
+    if failed > 0 {
+        return Err(Failure::Reported);
     }
+    Ok(())
 }
 
 fn histogram(values: impl Iterator<Item = usize>) -> String {

@@ -12,14 +12,28 @@ use gradmesh::{Document, Error};
 
 use crate::args::{Cli, Command};
 
+/// Why a command failed.
+pub enum Failure {
+    /// An error still to be printed.
+    Error(Error),
+    /// Errors the command printed as it went (`info` reports every file it cannot read).
+    Reported,
+}
+
+impl From<Error> for Failure {
+    fn from(e: Error) -> Self {
+        Failure::Error(e)
+    }
+}
+
 /// Runs the subcommand of `cli`.
-pub fn run(cli: Cli) -> Result<(), Error> {
+pub fn run(cli: Cli) -> Result<(), Failure> {
     match cli.command {
         Command::Info(a) => info::run(&a),
-        Command::Convert(a) => convert::run(&a),
-        Command::Refine(a) => refine::run(&a),
-        Command::Render(a) => render::run(&a),
-        Command::Edits(a) => edits::run(&a),
+        Command::Convert(a) => Ok(convert::run(&a)?),
+        Command::Refine(a) => Ok(refine::run(&a)?),
+        Command::Render(a) => Ok(render::run(&a)?),
+        Command::Edits(a) => Ok(edits::run(&a)?),
     }
 }
 

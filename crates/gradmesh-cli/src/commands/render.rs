@@ -84,34 +84,54 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
 
     let start = Instant::now();
     let mut doc = Document::default();
+    // For each layer of the document: the file it came from and its index there.
+    let mut origins = Vec::new();
     let limits = args.limits.limits();
     for path in &args.inputs {
-        doc.layers.extend(super::read(path, &limits)?.layers);
+        let layers = super::read(path, &limits)?.layers;
+        origins.extend((0..layers.len()).map(|i| (path.as_path(), i)));
+        doc.layers.extend(layers);
     }
     args.variant.apply(&mut doc);
     let read = start.elapsed();
+    let locate = |mut e: Error| {
+        if let Some(&(path, i)) = e.location.layer.and_then(|l| origins.get(l)) {
+            e.location.layer = Some(i);
+            e = e.in_file(path);
+        }
+        e
+    };
 
     let opts = options(args, &doc)?;
+    // The image's size and view are checked before its buffer is allocated.
+    opts.check()?;
     let start = Instant::now();
     let channels = 4 * opts.width as usize * opts.height as usize;
     // Straight into the output's channel type, unless outlines are drawn on top (on the `f32`
     // image): an `f32` image is four times the memory of 8-bit output.
     let (pixels, info) = if args.boundary {
-        let (mut image, info) = render::render_image(&doc, &opts)?;
-        render::draw_outlines(&doc, &opts, &mut image)?;
+        let (mut image, info) = render::render_image(&doc, &opts).map_err(locate)?;
+        render::draw_outlines(&doc, &opts, &mut image).map_err(locate)?;
         (Pixels::Float(image), info)
     } else if args.bits == 16 {
         let mut data = vec![0u16; channels];
-        let info = render::render_document_into(&doc, &opts, &mut data)?;
+        let info = render::render_document_into(&doc, &opts, &mut data).map_err(locate)?;
         (Pixels::Sixteen(data), info)
     } else {
         let mut data = vec![0u8; channels];
-        let info = render::render_document_into(&doc, &opts, &mut data)?;
+        let info = render::render_document_into(&doc, &opts, &mut data).map_err(locate)?;
         (Pixels::Eight(data), info)
     };
     let rendered = start.elapsed();
     for w in &info.warnings {
-        eprintln!("gradmesh: warning: {w}");
+        match w.layer.and_then(|l| origins.get(l)) {
+            Some(&(path, i)) => eprintln!(
+                "gradmesh: warning: {}: layer {i}: {}",
+                path.display(),
+                w.message
+            ),
+            None => eprintln!("gradmesh: warning: {w}"),
+        }
     }
 
     // Encoded straight into a temporary file (the PNG is never held in memory), which is

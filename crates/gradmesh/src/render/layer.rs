@@ -6,7 +6,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::colour::{ColourSpace, Matrix3};
-use crate::error::{Error, Warning};
+use crate::error::{Error, ErrorKind, Warning};
 use crate::limit;
 use crate::mesh::GradientMesh;
 use crate::refine::{RefinedMesh, Refinement};
@@ -548,6 +548,29 @@ pub(super) fn measure_quad(
     m
 }
 
+/// The level drawn when [`RenderOptions::level`] asks for `forced`: at least 2, and deep enough
+/// for the edits of level d to show fully (from level d + 1).
+fn forced_level(base: &BaseMesh, forced: usize) -> usize {
+    forced.max(2).max(base.edits.deepest_level() + 1)
+}
+
+/// Refuses a forced level whose quads, estimated from the base mesh before anything is built,
+/// would exceed [`RenderOptions::max_quads`].
+fn check_forced_level(base: &BaseMesh, forced: usize, opts: &RenderOptions) -> Result<(), Error> {
+    let k = forced_level(base, forced);
+    let estimate = crate::limits::estimate_refinement(base, k);
+    let quads = estimate.levels.get(k).map_or(u64::MAX, |c| c.faces);
+    if quads > opts.max_quads as u64 {
+        return Err(ErrorKind::LimitExceeded {
+            what: format!("the number of quads of refinement level {k}, the level asked for"),
+            found: quads,
+            limit: opts.max_quads as u64,
+        }
+        .into());
+    }
+    Ok(())
+}
+
 /// The limit data of level `k >= 2` (all quads), without copying the level's data.
 fn limit_of(refinement: &mut Refinement, data: &RefinedMesh, k: usize) -> Vec<VertexData> {
     match limit::limit_stencils(refinement.level(k)) {
@@ -598,10 +621,7 @@ fn choose_level(
         }
     };
     if let Some(forced) = opts.level {
-        // Edits of level d show fully from level d + 1.
-        let k = forced
-            .max(2)
-            .max(refinement.base().edits.deepest_level() + 1);
+        let k = forced_level(refinement.base(), forced);
         extend(refinement, data, k);
         let lim = limit_of(refinement, data, k);
         let choice = Choice {
@@ -803,6 +823,9 @@ pub(crate) fn prepare(
     // levels it needs (level 2 of a 10,000-face mesh alone took about 100 ms). An edited layer
     // whose topology stayed takes the levels its last preparation built.
     let (base, warnings) = BaseMesh::new(&mesh).map_err(|e| e.in_layer(index))?;
+    if let Some(forced) = opts.level {
+        check_forced_level(&base, forced, opts).map_err(|e| e.in_layer(index))?;
+    }
     let kept = memo.as_deref_mut().and_then(|m| m.refinement.take());
     let mut refinement = Refinement::rebased_or_new(kept, base, 1);
     // The edits' colours stay in the space they were written in.

@@ -132,6 +132,15 @@ use view::ToPixels;
 pub const MAX_SIDE: u32 = 1 << 15;
 /// The default largest pixel count ([`RenderOptions::max_pixels`]): 100 megapixels.
 pub const MAX_PIXELS: u64 = 100_000_000;
+/// The largest magnitude of a view's coordinates: that of a mesh's
+/// ([`crate::validate::MAX_MAGNITUDE`]).
+pub const MAX_VIEW_MAGNITUDE: f64 = crate::validate::MAX_MAGNITUDE;
+/// The smallest pixel, in plane units: a mesh's shortest edge
+/// ([`crate::validate::MIN_EDGE_LENGTH`]).
+pub const MIN_PIXEL_SIZE: f64 = crate::validate::MIN_EDGE_LENGTH;
+/// The smallest pixel relative to the view's largest coordinate (2^-32): smaller pixels leave
+/// too few bits of a coordinate to place anti-aliased edges within them.
+pub const MIN_RELATIVE_PIXEL_SIZE: f64 = 1.0 / 4_294_967_296.0;
 
 /// How to render a document.
 #[derive(Clone, Debug, PartialEq)]
@@ -234,7 +243,16 @@ impl RenderOptions {
         RenderOptions::new(width, height, View::new(cx - hw, cy - hh, cx + hw, cy + hh))
     }
 
-    fn check(&self) -> Result<(), Error> {
+    /// Refuses options that cannot be rendered: an empty image, a side above [`MAX_SIDE`], more
+    /// pixels than [`RenderOptions::max_pixels`], a view that is empty, not finite, beyond
+    /// ±[`MAX_VIEW_MAGNITUDE`] or whose pixels are smaller than its coordinates can resolve
+    /// ([`MIN_PIXEL_SIZE`], [`MIN_RELATIVE_PIXEL_SIZE`]), and tolerances or a background that
+    /// are not finite. (A forced [`RenderOptions::level`] is checked against
+    /// [`RenderOptions::max_quads`] for each layer, from its base mesh, before it is built.)
+    ///
+    /// Every render function calls it first, before allocating anything; a caller that
+    /// allocates its own output buffer for [`render_document_into`] calls it before that.
+    pub fn check(&self) -> Result<(), Error> {
         let invalid = |what: &str, message: String| -> Error {
             ErrorKind::Invalid {
                 what: what.into(),
@@ -248,15 +266,6 @@ impl RenderOptions {
                 format!("{}x{} has no pixels", self.width, self.height),
             ));
         }
-        let side = self.width.max(self.height);
-        if side > MAX_SIDE {
-            return Err(ErrorKind::LimitExceeded {
-                what: "image side".into(),
-                found: side as u64,
-                limit: MAX_SIDE as u64,
-            }
-            .into());
-        }
         let pixels = self.width as u64 * self.height as u64;
         if pixels > self.max_pixels {
             return Err(ErrorKind::LimitExceeded {
@@ -266,17 +275,16 @@ impl RenderOptions {
             }
             .into());
         }
-        let v = &self.view;
-        let finite = [v.x0, v.y0, v.x1, v.y1].iter().all(|x| x.is_finite());
-        if !finite || v.width() <= 0.0 || v.height() <= 0.0 {
-            return Err(invalid(
-                "view",
-                format!(
-                    "({}, {}) to ({}, {}) must have x1 > x0 and y1 > y0",
-                    v.x0, v.y0, v.x1, v.y1
-                ),
-            ));
+        let side = self.width.max(self.height);
+        if side > MAX_SIDE {
+            return Err(ErrorKind::LimitExceeded {
+                what: "image side".into(),
+                found: side as u64,
+                limit: MAX_SIDE as u64,
+            }
+            .into());
         }
+        self.check_view()?;
         for (name, value) in [
             ("tolerance", self.tolerance_px),
             ("colour tolerance", self.colour_tolerance),
@@ -290,6 +298,43 @@ impl RenderOptions {
             if bg.iter().any(|c| !c.is_finite()) {
                 return Err(invalid("background", format!("{bg:?} is not finite")));
             }
+        }
+        Ok(())
+    }
+
+    /// Refuses a view that is empty or not finite, reaches beyond ±[`MAX_VIEW_MAGNITUDE`], or
+    /// whose pixels are smaller than [`MIN_PIXEL_SIZE`] or than [`MIN_RELATIVE_PIXEL_SIZE`]
+    /// times its largest coordinate (adjacent pixels would map to the same plane coordinates).
+    fn check_view(&self) -> Result<(), Error> {
+        let v = &self.view;
+        let corners = [v.x0, v.y0, v.x1, v.y1];
+        let shown = format!("({:?}, {:?}) to ({:?}, {:?})", v.x0, v.y0, v.x1, v.y1);
+        let invalid = |message: String| -> Error {
+            ErrorKind::Invalid {
+                what: "view".into(),
+                message: format!("{shown}: {message}"),
+            }
+            .into()
+        };
+        if !corners.iter().all(|x| x.is_finite()) {
+            return Err(invalid("every coordinate must be a finite number".into()));
+        }
+        let largest = corners.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if largest > MAX_VIEW_MAGNITUDE {
+            return Err(invalid(format!(
+                "a coordinate is beyond ±{MAX_VIEW_MAGNITUDE:e}, the largest a mesh may have"
+            )));
+        }
+        if !(v.width() > 0.0 && v.height() > 0.0) {
+            return Err(invalid("x1 must exceed x0 and y1 must exceed y0".into()));
+        }
+        let pixel = (v.width() / self.width as f64).min(v.height() / self.height as f64);
+        let smallest = MIN_PIXEL_SIZE.max(MIN_RELATIVE_PIXEL_SIZE * largest);
+        if pixel < smallest {
+            return Err(invalid(format!(
+                "a pixel would be {pixel:e} units across, below the {smallest:e} that \
+                 coordinates of this size resolve"
+            )));
         }
         Ok(())
     }

@@ -9,6 +9,8 @@
 
 #![allow(dead_code)]
 
+pub mod render;
+
 use arbitrary::Arbitrary;
 use gradmesh::formats::{self, json, Format};
 use gradmesh::refine::Refinement;
@@ -111,8 +113,9 @@ pub fn check_mesh(mesh: &GradientMesh, depth: usize) {
         &format!("the limit of level {depth}"),
     );
     let base = refinement.base();
+    let near_edits = points_next_to_edits(mesh);
     for v in 0..base.topology.vertex_count() {
-        if base.topology.vertex_faces(v).is_empty() {
+        if near_edits.contains(&base.source_point[v]) {
             continue;
         }
         let at = refinement.vertex_at_level(v as u32, depth);
@@ -126,16 +129,20 @@ pub fn check_mesh(mesh: &GradientMesh, depth: usize) {
     }
 }
 
-/// Asserts that the data of every vertex of `topology` that lies on a face is finite.
-///
-/// Vertices on no face are skipped: a point used by no face (legal, with a warning) becomes NaN
-/// from level 2 on, because the Catmull-Clark vertex rule divides by its valence 0 (reported;
-/// see `isolated_points_stay_finite` in tests/degenerate.rs).
-fn assert_finite(data: &[[f64; 6]], topology: &gradmesh::Topology, what: &str) {
+/// The control points whose limit colour a multi-resolution edit changes: those with an edit
+/// on their own vertex or next to it (sector coordinates both at most 1), whose ring after the
+/// next step overlaps the point's (see the module docs of `gradmesh::edits`).
+fn points_next_to_edits(mesh: &GradientMesh) -> std::collections::HashSet<u32> {
+    mesh.edits
+        .iter()
+        .filter(|e| e.address.at[0] <= 1 && e.address.at[1] <= 1)
+        .map(|e| e.address.point)
+        .collect()
+}
+
+/// Asserts that the data of every vertex of `topology` is finite.
+fn assert_finite(data: &[[f64; 6]], _topology: &gradmesh::Topology, what: &str) {
     for (i, d) in data.iter().enumerate() {
-        if topology.vertex_faces(i).is_empty() {
-            continue;
-        }
         assert!(
             d.iter().all(|x| x.is_finite()),
             "{what}: vertex {i} is not finite: {d:?}"
@@ -306,46 +313,11 @@ impl MeshDescription {
             p.opacity = self.opacity.get(k).map_or(1.0, |&o| o as f64 / 255.0);
             p.corner = self.corners.contains(&(k as u8));
         }
-        // Edges of the faces, in a fixed order, for handles and tags.
-        let mut edges = Vec::new();
-        for f in &mesh.faces {
-            for k in 0..f.len() {
-                edges.push((f[k], f[(k + 1) % f.len()]));
-            }
+        for &(p, slot, len, turn) in self.handles.iter().take(32) {
+            set_handle_by_slot(&mut mesh, p, slot, len, turn);
         }
-        if !edges.is_empty() {
-            for &(p, slot, len, turn) in self.handles.iter().take(32) {
-                let ring: Vec<u32> = edges
-                    .iter()
-                    .filter_map(|&(a, b)| {
-                        (a == p as u32 % n as u32)
-                            .then_some(b)
-                            .or_else(|| (b == p as u32 % n as u32).then_some(a))
-                    })
-                    .collect();
-                let from = p as u32 % n as u32;
-                let Some(&to) = ring.get(slot as usize % ring.len().max(1)) else {
-                    continue;
-                };
-                let d = mesh.points[to as usize].position - mesh.points[from as usize].position;
-                let (s, c) = (turn as f64 / 64.0).sin_cos();
-                let r = len as f64 / 8.0;
-                mesh.set_handle(
-                    from,
-                    to,
-                    Vec2::new(r * (c * d.x - s * d.y), r * (s * d.x + c * d.y)),
-                );
-            }
-            for &(slot, kind, sharpness) in self.edges.iter().take(16) {
-                let (a, b) = edges[slot as usize % edges.len()];
-                let (kind, s) = match kind % 4 {
-                    0 => (EdgeKind::Crease, None),
-                    1 => (EdgeKind::Crease, Some(sharpness as f64 / 4.0)),
-                    2 => (EdgeKind::Discontinuous, None),
-                    _ => (EdgeKind::Smooth, None),
-                };
-                mesh.set_edge(a, b, kind, s);
-            }
+        for &(slot, kind, sharpness) in self.edges.iter().take(16) {
+            set_edge_by_slot(&mut mesh, slot, kind, sharpness);
         }
         if !mesh.faces.is_empty() {
             for &(p, f, c, o) in self.wedges.iter().take(8) {
@@ -368,8 +340,61 @@ impl MeshDescription {
     }
 }
 
+/// The edges of the faces of `mesh`, in a fixed order, for handles and tags.
+fn face_edges(mesh: &GradientMesh) -> Vec<(u32, u32)> {
+    let mut edges = Vec::new();
+    for f in &mesh.faces {
+        for k in 0..f.len() {
+            edges.push((f[k], f[(k + 1) % f.len()]));
+        }
+    }
+    edges
+}
+
+/// Sets the handle of point `p` (modulo the point count) towards its neighbour in `slot`: `len`
+/// eighths of the edge, turned by `turn` / 64 radians. Nothing when the point has no edge.
+pub fn set_handle_by_slot(mesh: &mut GradientMesh, p: u8, slot: u8, len: u8, turn: i8) {
+    let n = mesh.points.len() as u32;
+    if n == 0 {
+        return;
+    }
+    let from = p as u32 % n;
+    let ring: Vec<u32> = face_edges(mesh)
+        .iter()
+        .filter_map(|&(a, b)| (a == from).then_some(b).or((b == from).then_some(a)))
+        .collect();
+    let Some(&to) = ring.get(slot as usize % ring.len().max(1)) else {
+        return;
+    };
+    let d = mesh.points[to as usize].position - mesh.points[from as usize].position;
+    let (s, c) = (turn as f64 / 64.0).sin_cos();
+    let r = len as f64 / 8.0;
+    mesh.set_handle(
+        from,
+        to,
+        Vec2::new(r * (c * d.x - s * d.y), r * (s * d.x + c * d.y)),
+    );
+}
+
+/// Tags the face edge in `slot` (modulo the edge count): crease, semi-sharp crease of
+/// `sharpness` / 4, discontinuous or smooth, by `kind`.
+pub fn set_edge_by_slot(mesh: &mut GradientMesh, slot: u8, kind: u8, sharpness: u8) {
+    let edges = face_edges(mesh);
+    if edges.is_empty() {
+        return;
+    }
+    let (a, b) = edges[slot as usize % edges.len()];
+    let (kind, s) = match kind % 4 {
+        0 => (EdgeKind::Crease, None),
+        1 => (EdgeKind::Crease, Some(sharpness as f64 / 4.0)),
+        2 => (EdgeKind::Discontinuous, None),
+        _ => (EdgeKind::Smooth, None),
+    };
+    mesh.set_edge(a, b, kind, s);
+}
+
 /// A colour from three bytes, spread over the usual range of `space`.
-fn colour_in(space: ColourSpace, c: [i8; 3]) -> [f64; 3] {
+pub fn colour_in(space: ColourSpace, c: [i8; 3]) -> [f64; 3] {
     let unit = |v: i8| (v as f64 + 128.0) / 255.0;
     match space {
         ColourSpace::Lab => [100.0 * unit(c[0]), c[1] as f64, c[2] as f64],
@@ -396,6 +421,7 @@ pub fn run_target(target: &str, data: &[u8]) {
     match format_of_target(target) {
         Some(format) => parse(format, data),
         None if target == "pipeline" => pipeline_bytes(data),
+        None if target == "render" => render::render_bytes(data),
         None => panic!("unknown fuzz target {target}"),
     }
 }
