@@ -158,8 +158,8 @@ pub enum ErrorKind {
     /// A limit protecting against runaway input was exceeded.
     #[error(
         "{what} is {}, above the limit of {}",
-        crate::limits::group_digits(*.found),
-        crate::limits::group_digits(*.limit)
+        group_digits(*.found),
+        group_digits(*.limit)
     )]
     LimitExceeded {
         /// What was counted.
@@ -253,3 +253,16 @@ impl fmt::Display for Warning {
 
 /// Result with this crate's error.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// `1234567` as `1,234,567`.
+pub fn group_digits(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::with_capacity(digits.len() + digits.len() / 3);
+    for (i, ch) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(ch);
+    }
+    out
+}

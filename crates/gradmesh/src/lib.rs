@@ -35,27 +35,31 @@
 pub mod binary_step;
 pub mod catmull_clark;
 pub mod colour;
+pub mod edit_check;
 pub mod edits;
 pub mod error;
 pub mod formats;
+pub mod level;
 pub mod limit;
 pub mod limits;
 pub mod mesh;
+pub mod multires;
 pub mod refine;
 pub mod render;
 pub mod rules;
+pub mod scheme;
 pub mod ternary_step;
 pub mod topology;
 pub mod validate;
 
 pub use colour::ColourSpace;
-pub use edits::{ColourEdit, Edit, FineEdits, OpacityEdit, VertexAddress};
 pub use error::{Error, ErrorKind, Location, Result, Warning};
 pub use limits::Limits;
 pub use mesh::{
     BoundaryInterpolation, ControlPoint, CreasingMethod, Document, EdgeKind, EdgeTag, FirstStep,
     GradientMesh, WedgeOverride,
 };
+pub use multires::{ColourEdit, Edit, FineEdits, OpacityEdit, VertexAddress};
 pub use refine::{RefinedMesh, Refinement};
 pub use topology::Topology;
 pub use validate::validate;

@@ -25,7 +25,8 @@
 use std::fmt::Write as _;
 
 use crate::error::{Error, ErrorKind};
-use crate::mesh::{FirstStep, GradientMesh, SHARPNESS_INFINITE};
+use crate::mesh::GradientMesh;
+use crate::scheme::{FirstStep, SHARPNESS_INFINITE};
 use crate::validate::BaseMesh;
 
 /// Bounds on the size of inputs and of refinements.
@@ -337,18 +338,7 @@ pub fn estimate_counts(
     RefinementEstimate { levels, bytes }
 }
 
-/// `1234567` as `1,234,567`.
-pub fn group_digits(n: u64) -> String {
-    let digits = n.to_string();
-    let mut out = String::with_capacity(digits.len() + digits.len() / 3);
-    for (i, ch) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i) % 3 == 0 {
-            out.push(',');
-        }
-        out.push(ch);
-    }
-    out
-}
+pub use crate::error::group_digits;
 
 /// A byte count for people: `9.8 GB`, `512 kB` (powers of 1000).
 pub fn human_bytes(bytes: u64) -> String {

@@ -5,10 +5,8 @@ use std::collections::BTreeMap;
 use kurbo::{Point, Vec2};
 
 use crate::colour::ColourSpace;
-use crate::edits::{Edit, FineEdits, VertexAddress};
-
-/// Sharpness at or above this value is infinite (OpenSubdiv's `SHARPNESS_INFINITE`).
-pub const SHARPNESS_INFINITE: f64 = 10.0;
+use crate::multires::{Edit, FineEdits, VertexAddress};
+pub use crate::scheme::{BoundaryInterpolation, CreasingMethod, FirstStep, SHARPNESS_INFINITE};
 
 /// A picture: gradient meshes drawn in order, the first at the bottom.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -86,69 +84,6 @@ impl EdgeTag {
             EdgeKind::Crease => self.sharpness.unwrap_or(SHARPNESS_INFINITE),
             // Discontinuous edges become boundaries; their sharpness is that of a boundary.
             EdgeKind::Discontinuous => SHARPNESS_INFINITE,
-        }
-    }
-}
-
-/// How the boundary of a mesh is refined (OpenSubdiv's `VtxBoundaryInterpolation`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum BoundaryInterpolation {
-    /// Boundary edges are sharp and boundary points with a single face are corners (the default,
-    /// and what the paper's authors do: a rectangle keeps its corners).
-    #[default]
-    EdgeAndCorner,
-    /// Boundary edges are sharp; every boundary point follows the B-spline rule.
-    EdgeOnly,
-}
-
-impl BoundaryInterpolation {
-    /// The name used in files and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            BoundaryInterpolation::EdgeAndCorner => "edge-and-corner",
-            BoundaryInterpolation::EdgeOnly => "edge-only",
-        }
-    }
-}
-
-/// How the sharpness of semi-sharp edges decreases from one level to the next.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum CreasingMethod {
-    /// Subtract one at each level.
-    #[default]
-    Uniform,
-    /// Chaikin's rule: blend with the sharpness of neighbouring semi-sharp edges, then subtract one.
-    Chaikin,
-}
-
-impl CreasingMethod {
-    /// The name used in files and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            CreasingMethod::Uniform => "uniform",
-            CreasingMethod::Chaikin => "chaikin",
-        }
-    }
-}
-
-/// The special first refinement that makes colours interpolating (paper sections 4.3 and 4.5).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum FirstStep {
-    /// One linear ternary split (the paper's choice, the default): a face of `n` corners
-    /// becomes a central `n`-gon surrounded by `2 n` quads.
-    #[default]
-    Ternary,
-    /// Two linear binary splits (the paper's alternative): a face of `n` corners becomes `4 n`
-    /// quads, with more points to place (see `docs/binary-step.md`).
-    Binary,
-}
-
-impl FirstStep {
-    /// The name used in files and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            FirstStep::Ternary => "ternary",
-            FirstStep::Binary => "binary",
         }
     }
 }

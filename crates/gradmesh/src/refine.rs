@@ -11,11 +11,13 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use crate::binary_step;
 use crate::catmull_clark::{self, Level, Stencils};
 use crate::colour::ColourSpace;
-use crate::edits::{self, Edit, FineEdits};
+use crate::edit_check::check_edits;
+use crate::edits;
 use crate::error::{Error, Warning};
 use crate::limit;
 use crate::limits::Limits;
 use crate::mesh::{FirstStep, GradientMesh};
+use crate::multires::{Edit, FineEdits};
 use crate::rules;
 use crate::ternary_step;
 use crate::topology::Topology;
@@ -48,10 +50,10 @@ pub struct RefinedMesh {
 }
 
 impl Refinement {
-    /// Validates `mesh` and refines its topology down to level `depth`.
+    /// Validates `mesh` and refines its topology down to level `depth`, within
+    /// [`Limits::DEFAULT`] (see [`Refinement::new_with_limits`]).
     pub fn new(mesh: &GradientMesh, depth: usize) -> Result<(Refinement, Vec<Warning>), Error> {
-        let (base, warnings) = BaseMesh::new(mesh)?;
-        Ok((Refinement::from_base(base, depth), warnings))
+        Refinement::new_with_limits(mesh, depth, &Limits::DEFAULT)
     }
 
     /// As [`Refinement::new`], but first refuses a mesh beyond `limits` (points, faces,
@@ -74,7 +76,10 @@ impl Refinement {
         Ok((Refinement::from_base(base, depth), warnings))
     }
 
-    /// Refines the topology of an already validated base level down to level `depth`.
+    /// Refines the topology of an already validated base level down to level `depth`, with no
+    /// limit: check the refinement first ([`Limits::check_refinement`]) when the base comes from
+    /// untrusted input. With interpolated positions it builds the levels their limit stencils
+    /// need (below every semi-sharp feature: up to level 12).
     pub fn from_base(base: BaseMesh, depth: usize) -> Refinement {
         let mut r = Refinement {
             base,
@@ -281,7 +286,15 @@ impl Refinement {
     pub fn set_edits(&mut self, edits: &[Edit], fine: FineEdits) -> Result<(), Error> {
         let space = self.base.edits.space;
         let working = self.base.edits.working;
-        let mut set = edits::check_edits(&self.base, edits, fine, space)?;
+        let base = &self.base;
+        let mut set = check_edits(
+            &base.topology,
+            &base.source_point,
+            base.first_step,
+            edits,
+            fine,
+            space,
+        )?;
         set.working = working;
         self.base.edits = set;
         Ok(())

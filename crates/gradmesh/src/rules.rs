@@ -3,7 +3,7 @@
 //! Only rules: which vertex rule applies, how sharpness decays, and how a vertex whose rule
 //! changes between levels blends the two masks. No mesh type appears here.
 
-use crate::mesh::{CreasingMethod, SHARPNESS_INFINITE};
+use crate::scheme::{CreasingMethod, SHARPNESS_INFINITE};
 
 /// The rule that computes a vertex point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]

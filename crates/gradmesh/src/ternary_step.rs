@@ -10,7 +10,7 @@ use std::ops::Range;
 
 use kurbo::{Point, Vec2};
 
-use crate::catmull_clark::Level;
+use crate::level::Level;
 use crate::topology::{Topology, INVALID, PARALLEL_MIN_CORNERS};
 use crate::validate::{BaseMesh, VertexData};
 

@@ -8,29 +8,16 @@ use std::collections::{BTreeMap, HashMap};
 
 use kurbo::Vec2;
 
-use crate::edits::{check_edits, EditSet};
+use crate::edit_check::{check_edits, EditSet};
 use crate::error::{Error, ErrorKind, Warning};
 use crate::mesh::{
     edge_key, BoundaryInterpolation, CreasingMethod, EdgeKind, FirstStep, GradientMesh,
 };
 use crate::topology::{flatten, Topology};
 
-/// The largest magnitude of a coordinate, handle component or colour channel: the refinement
-/// squares differences of positions, which overflow beyond about 1e154.
-pub const MAX_MAGNITUDE: f64 = 1e150;
-
-/// The largest magnitude of a coordinate of a mesh with
-/// [`GradientMesh::interpolate_positions`]: the correction measures each point's weight by
-/// moving it one unit, which is lost in rounding at larger coordinates.
-pub const MAX_INTERPOLATED_MAGNITUDE: f64 = 1e12;
-
-/// The shortest edge refined: squared lengths of shorter edges underflow to zero.
-pub const MIN_EDGE_LENGTH: f64 = 1e-150;
-
-/// The most times a handle may be longer than its edge: the ternary step multiplies the two
-/// ratios of a corner's handles, which must stay far from overflow. (Handles longer than half
-/// their edge are already warned about.)
-pub const MAX_HANDLE_RATIO: f64 = 1e50;
+pub use crate::scheme::{
+    MAX_HANDLE_RATIO, MAX_INTERPOLATED_MAGNITUDE, MAX_MAGNITUDE, MIN_EDGE_LENGTH,
+};
 
 /// Per-vertex data carried through refinement: `[x, y, c0, c1, c2, opacity]`.
 pub type VertexData = [f64; 6];
@@ -408,7 +395,14 @@ impl BaseMesh {
             warnings,
         ))
         .and_then(|(mut base, warnings)| {
-            base.edits = check_edits(&base, &mesh.edits, mesh.fine_edits, mesh.colour_space)?;
+            base.edits = check_edits(
+                &base.topology,
+                &base.source_point,
+                base.first_step,
+                &mesh.edits,
+                mesh.fine_edits,
+                mesh.colour_space,
+            )?;
             Ok((base, warnings))
         })
     }

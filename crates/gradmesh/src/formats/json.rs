@@ -13,13 +13,13 @@ use kurbo::{Point, Vec2};
 use serde::de::{self, Deserialize, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
 
 use crate::colour::{parse_css_colour, ColourSpace};
-use crate::edits::{ColourEdit, Edit, FineEdits, OpacityEdit, VertexAddress};
 use crate::error::{Error, ErrorKind, Location};
 use crate::limits::Limits;
 use crate::mesh::{
     edge_key, BoundaryInterpolation, ControlPoint, CreasingMethod, Document, EdgeKind, EdgeTag,
     FirstStep, GradientMesh, WedgeOverride,
 };
+use crate::multires::{ColourEdit, Edit, FineEdits, OpacityEdit, VertexAddress};
 use crate::topology::Topology;
 use crate::validate::VertexData;
 

@@ -34,7 +34,7 @@ use crate::rules;
 use crate::topology::Topology;
 use crate::validate::VertexData;
 
-use super::layer::{measure_quad, Measure, QuadSamples, Thresholds};
+use super::measure::{measure_quad, Measure, QuadSamples, Thresholds};
 use super::nearest::Segment;
 use super::patches::{
     regular_corners, regular_patch_with, ControlGrid, Grid, LocalPatch, ShapeCache,
@@ -1456,7 +1456,7 @@ fn turn_flags(g: &[VertexData], step: usize, n: usize) -> u8 {
 
 /// Whether points (pixels) surely lie between two adjacent columns, or two adjacent rows, of
 /// pixel centres, so that no triangle through them covers a centre. Cheap, and sure: the
-/// margin covers the snapping that the exact test (in [`super::layer::screen_triangle_px`])
+/// margin covers the snapping that the exact test (in [`super::triangles::screen_triangle_px`])
 /// works on.
 fn between_pixel_centres<const N: usize>(p: [[f64; 2]; N]) -> bool {
     // A sixty-fourth of a pixel: far more than the snapping moves a point.
@@ -1481,7 +1481,7 @@ fn between_pixel_centres<const N: usize>(p: [[f64; 2]; N]) -> bool {
 }
 
 /// The triangle through three limit samples, in pixels, quadratic with the side nodes `mids`
-/// (within the colour `bounds`), if it may cover a pixel centre of the image (see [`super::layer::screen_triangle_px`]).
+/// (within the colour `bounds`), if it may cover a pixel centre of the image (see [`super::triangles::screen_triangle_px`]).
 fn screen_triangle(
     d: [&VertexData; 3],
     mids: Option<[[f64; 4]; 3]>,
@@ -1491,7 +1491,7 @@ fn screen_triangle(
 ) -> Option<Triangle> {
     let exact = each3(|k| xf.apply(d[k][0], d[k][1]));
     let attr = each3(|k| [d[k][2], d[k][3], d[k][4], d[k][5]]);
-    super::layer::screen_triangle_px(exact, attr, mids, bounds, size)
+    super::triangles::screen_triangle_px(exact, attr, mids, bounds, size)
 }
 
 #[cfg(test)]
@@ -1561,7 +1561,8 @@ mod tests {
                             let corners = tri.map(|k| quad[k]);
                             let size = (2048, 2048);
                             assert!(
-                                crate::render::layer::snapped_if_visible(corners, size).is_none(),
+                                crate::render::triangles::snapped_if_visible(corners, size)
+                                    .is_none(),
                                 "{corners:?} was skipped but may cover a pixel centre"
                             );
                         }

@@ -95,6 +95,7 @@ mod coverage;
 mod folds;
 mod gamut;
 mod layer;
+mod measure;
 mod nearest;
 mod outline;
 mod output;
@@ -609,6 +610,9 @@ fn render<P: OutputPixel>(
             let memo = memo.as_deref_mut().filter(|_| entry.is_some());
             layer::prepare(mesh, i, opts, &xf, &shapes, memo).map(Some)
         })
+        .collect::<Vec<_>>()
+        // The first failing layer's error, whatever the thread count.
+        .into_iter()
         .collect::<Result<_, _>>()?;
     drop(memos);
     let reused: Vec<bool> = fresh.iter().map(Option::is_none).collect();

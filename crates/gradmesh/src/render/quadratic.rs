@@ -19,7 +19,7 @@
 use crate::validate::VertexData;
 
 use super::each4;
-use super::layer::sample_error;
+use super::measure::sample_error;
 use super::view::ToPixels;
 use crate::colour::{ColourSpace, Matrix3};
 

@@ -706,6 +706,47 @@ impl Triangle {
     }
 }
 
+/// The triangle through three points (pixels) with attributes `attr` (and quadratic, with the
+/// side nodes `mids`, and the layer's colour `bounds`), snapped, if it may cover a pixel centre
+/// of a `size` image.
+pub(super) fn screen_triangle_px(
+    exact: [[f64; 2]; 3],
+    attr: [[f64; 4]; 3],
+    mids: Option<[[f64; 4]; 3]>,
+    bounds: &Bounds,
+    size: (i64, i64),
+) -> Option<Triangle> {
+    let v = snapped_if_visible(exact, size)?;
+    let tri = Triangle::new_quadratic(v, exact, attr, mids, bounds)?;
+    let rows = tri.rows();
+    (rows.1 > 0 && rows.0 < size.1 && rows.0 < rows.1).then_some(tri)
+}
+
+/// The snapped corners of the triangle through three points (pixels), unless it surely covers
+/// no pixel centre of a `size` image: it lies beside the image, or no column of pixel centres
+/// runs between its leftmost and rightmost corner, or no row between its lowest and highest
+/// (at deep levels most cells are under a pixel).
+pub(super) fn snapped_if_visible(exact: [[f64; 2]; 3], size: (i64, i64)) -> Option<[[i64; 2]; 3]> {
+    let (w, h) = size;
+    let (xmax, ymax) = (w * SUBPIXEL, h * SUBPIXEL);
+    let snapped = |p: [f64; 2]| Some([snap(p[0])?, snap(p[1])?]);
+    let v = [snapped(exact[0])?, snapped(exact[1])?, snapped(exact[2])?];
+    let outside = v.iter().all(|p| p[0] < 0)
+        || v.iter().all(|p| p[0] > xmax)
+        || v.iter().all(|p| p[1] < 0)
+        || v.iter().all(|p| p[1] > ymax);
+    // No column (row) of pixel centres runs between the least and the greatest x (y): the
+    // row test is the triangle's own (`Triangle::rows`), made before building it.
+    let half = SUBPIXEL / 2;
+    let none_between = |axis: usize| {
+        let lo = v.iter().map(|p| p[axis]).min().expect("three vertices");
+        let hi = v.iter().map(|p| p[axis]).max().expect("three vertices");
+        (lo - half).div_euclid(SUBPIXEL) == (hi - half).div_euclid(SUBPIXEL)
+            && (lo - half).rem_euclid(SUBPIXEL) != 0
+    };
+    (!outside && !none_between(0) && !none_between(1)).then_some(v)
+}
+
 #[cfg(test)]
 mod tests {
     /// `snap` rounds exactly as `f64::round` does, halves and limits included.

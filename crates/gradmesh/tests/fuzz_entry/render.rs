@@ -103,7 +103,7 @@ pub enum Edit {
 }
 
 impl Edit {
-    fn apply(&self, doc: &mut Document) {
+    pub fn apply(&self, doc: &mut Document) {
         fn layer(doc: &mut Document, i: u8) -> Option<&mut GradientMesh> {
             let n = doc.layers.len();
             (n > 0).then(|| &mut doc.layers[i as usize % n])
