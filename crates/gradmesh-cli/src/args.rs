@@ -3,7 +3,9 @@
 use std::path::PathBuf;
 
 use clap::builder::TypedValueParser as _;
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use gradmesh::render::GamutMapping;
+use gradmesh::Limits;
 
 /// Gradient meshes of arbitrary topology (Lieng, Kosinka, Shen & Dodgson 2017).
 #[derive(Debug, Parser)]
@@ -29,7 +31,6 @@ pub enum Command {
     Edits(EditsArgs),
 }
 
-/// Limits on the input (`gradmesh::Limits`), raised for trusted input.
 /// The paper's options (section 4.5), applied to every layer; without them each layer keeps
 /// what its file says.
 #[derive(Debug, Args)]
@@ -39,8 +40,26 @@ pub struct VariantArgs {
     #[arg(long)]
     pub interpolate_positions: bool,
     /// The first refinement: ternary (the paper's) or binary (two binary splits).
-    #[arg(long, value_name = "STEP", value_parser = ["ternary", "binary"])]
-    pub first_step: Option<String>,
+    #[arg(long, value_name = "STEP")]
+    pub first_step: Option<FirstStepArg>,
+}
+
+/// `--first-step`.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum FirstStepArg {
+    /// The paper's ternary step.
+    Ternary,
+    /// Two binary splits.
+    Binary,
+}
+
+impl From<FirstStepArg> for gradmesh::FirstStep {
+    fn from(step: FirstStepArg) -> Self {
+        match step {
+            FirstStepArg::Ternary => gradmesh::FirstStep::Ternary,
+            FirstStepArg::Binary => gradmesh::FirstStep::Binary,
+        }
+    }
 }
 
 impl VariantArgs {
@@ -50,42 +69,82 @@ impl VariantArgs {
             if self.interpolate_positions {
                 mesh.interpolate_positions = true;
             }
-            match self.first_step.as_deref() {
-                Some("binary") => mesh.first_step = gradmesh::FirstStep::Binary,
-                Some("ternary") => mesh.first_step = gradmesh::FirstStep::Ternary,
-                _ => {}
+            if let Some(step) = self.first_step {
+                mesh.first_step = step.into();
             }
         }
     }
 }
 
+/// Limits on the input (`gradmesh::Limits`), raised for trusted input.
 #[derive(Debug, Args)]
 #[command(next_help_heading = "Limits")]
 pub struct LimitArgs {
-    /// Largest input file, in bytes [default: 268435456].
-    #[arg(long, value_name = "BYTES")]
-    pub max_input_bytes: Option<u64>,
-    /// Most control points in one mesh [default: 16777216].
-    #[arg(long, value_name = "N")]
-    pub max_points: Option<u64>,
-    /// Most faces in one mesh [default: 16777216].
-    #[arg(long, value_name = "N")]
-    pub max_faces: Option<u64>,
-    /// Most face corners in one mesh [default: 67108864].
-    #[arg(long, value_name = "N")]
-    pub max_corners: Option<u64>,
+    /// Largest input file, in bytes.
+    #[arg(long, value_name = "BYTES", default_value_t = Limits::DEFAULT.input_bytes)]
+    pub max_input_bytes: u64,
+    /// Most control points in one mesh.
+    #[arg(long, value_name = "N", default_value_t = Limits::DEFAULT.points)]
+    pub max_points: u64,
+    /// Most faces in one mesh.
+    #[arg(long, value_name = "N", default_value_t = Limits::DEFAULT.faces)]
+    pub max_faces: u64,
+    /// Most face corners in one mesh.
+    #[arg(long, value_name = "N", default_value_t = Limits::DEFAULT.corners)]
+    pub max_corners: u64,
 }
 
 impl LimitArgs {
     /// The default limits, with the flags given.
-    pub fn limits(&self) -> gradmesh::Limits {
-        let d = gradmesh::Limits::DEFAULT;
-        gradmesh::Limits {
-            input_bytes: self.max_input_bytes.unwrap_or(d.input_bytes),
-            points: self.max_points.unwrap_or(d.points),
-            faces: self.max_faces.unwrap_or(d.faces),
-            corners: self.max_corners.unwrap_or(d.corners),
-            ..d
+    pub fn limits(&self) -> Limits {
+        Limits {
+            input_bytes: self.max_input_bytes,
+            points: self.max_points,
+            faces: self.max_faces,
+            corners: self.max_corners,
+            ..Limits::DEFAULT
+        }
+    }
+}
+
+/// `--colour-space`.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum ColourSpaceArg {
+    /// CIE Lab (D65).
+    Lab,
+    /// Oklab.
+    Oklab,
+    /// Linear-light sRGB.
+    SrgbLinear,
+    /// sRGB.
+    Srgb,
+}
+
+impl From<ColourSpaceArg> for gradmesh::ColourSpace {
+    fn from(space: ColourSpaceArg) -> Self {
+        match space {
+            ColourSpaceArg::Lab => gradmesh::ColourSpace::Lab,
+            ColourSpaceArg::Oklab => gradmesh::ColourSpace::Oklab,
+            ColourSpaceArg::SrgbLinear => gradmesh::ColourSpace::SrgbLinear,
+            ColourSpaceArg::Srgb => gradmesh::ColourSpace::Srgb,
+        }
+    }
+}
+
+/// `--gamut`.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum GamutArg {
+    /// Reduce chroma in Oklch until the colour fits (CSS Color 4).
+    Chroma,
+    /// Clip each channel.
+    Clip,
+}
+
+impl From<GamutArg> for GamutMapping {
+    fn from(gamut: GamutArg) -> Self {
+        match gamut {
+            GamutArg::Chroma => GamutMapping::Chroma,
+            GamutArg::Clip => GamutMapping::Clip,
         }
     }
 }
@@ -150,12 +209,12 @@ pub struct RefineArgs {
     /// The paper's options.
     #[command(flatten)]
     pub variant: VariantArgs,
-    /// Deepest refinement level accepted [default: 12].
-    #[arg(long, value_name = "LEVEL", help_heading = "Limits")]
-    pub max_level: Option<usize>,
-    /// Most faces of the deepest level, estimated before refining [default: 8388608].
-    #[arg(long, value_name = "N", help_heading = "Limits")]
-    pub max_refined_faces: Option<u64>,
+    /// Deepest refinement level accepted.
+    #[arg(long, value_name = "LEVEL", help_heading = "Limits", default_value_t = Limits::DEFAULT.refinement_level)]
+    pub max_level: usize,
+    /// Most faces of the deepest level, estimated before refining.
+    #[arg(long, value_name = "N", help_heading = "Limits", default_value_t = Limits::DEFAULT.refined_faces)]
+    pub max_refined_faces: u64,
     /// Limits.
     #[command(flatten)]
     pub limits: LimitArgs,
@@ -189,18 +248,18 @@ pub struct RenderArgs {
     /// Do not dither 8-bit output.
     #[arg(long)]
     pub no_dither: bool,
-    /// Interpolate colour linearly over every triangle (no quadratic faces: more triangles, as before 2026-12).
+    /// Interpolate colour linearly over every triangle (no quadratic faces: more triangles).
     #[arg(long)]
     pub linear_colour: bool,
     /// Draw the outline of each mesh on top, one pixel wide.
     #[arg(long)]
     pub boundary: bool,
-    /// Interpolate in this colour space instead of each mesh's own: lab, oklab, srgb-linear, srgb.
-    #[arg(long)]
-    pub colour_space: Option<String>,
-    /// Gamut mapping of out-of-gamut colours: chroma (reduce chroma in Oklch) or clip.
-    #[arg(long)]
-    pub gamut: Option<String>,
+    /// Interpolate in this colour space instead of each mesh's own.
+    #[arg(long, value_name = "SPACE")]
+    pub colour_space: Option<ColourSpaceArg>,
+    /// Gamut mapping of out-of-gamut colours.
+    #[arg(long, default_value = "chroma")]
+    pub gamut: GamutArg,
     /// Slow and simple reference rendering (for checking the fast path).
     #[arg(long)]
     pub reference: bool,

@@ -31,7 +31,7 @@ impl Level {
         boundary: BoundaryInterpolation,
     ) -> Level {
         // Found from the boundary edges: in a manifold fan, the boundary vertices are their
-        // ends (a test per vertex cost the 10,000-face setup a tenth of its instructions).
+        // ends (a test per vertex is a noticeable share of a large mesh's setup).
         let corners = boundary == BoundaryInterpolation::EdgeAndCorner;
         for (e, s) in edge_sharpness.iter_mut().enumerate() {
             if topology.is_boundary_edge(e) {

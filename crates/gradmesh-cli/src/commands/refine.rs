@@ -19,13 +19,11 @@ pub fn run(args: &RefineArgs) -> Result<(), Error> {
             )))
         })?;
     super::check_not_input(&args.output, &[&args.input], args.force)?;
-    let mut limits = args.limits.limits();
-    if let Some(level) = args.max_level {
-        limits.refinement_level = level;
-    }
-    if let Some(faces) = args.max_refined_faces {
-        limits.refined_faces = faces;
-    }
+    let limits = Limits {
+        refinement_level: args.max_level,
+        refined_faces: args.max_refined_faces,
+        ..args.limits.limits()
+    };
     let mut doc = super::read(&args.input, &limits)?;
     args.variant.apply(&mut doc);
     let mut layers = Vec::with_capacity(doc.layers.len());

@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use gradmesh::colour::parse_css_colour;
 use gradmesh::formats;
-use gradmesh::render::{self, GamutMapping, RenderOptions, View};
+use gradmesh::render::{self, RenderOptions, View};
 use gradmesh::{ColourSpace, Document, Error, ErrorKind};
 
 use crate::args::RenderArgs;
@@ -43,22 +43,8 @@ fn options(args: &RenderArgs, doc: &Document) -> Result<RenderOptions, Error> {
             .map_err(|e| invalid("--background", format!("{bg:?}: {e}")))?;
         opts.background = Some([rgb[0], rgb[1], rgb[2], alpha]);
     }
-    if let Some(name) = &args.colour_space {
-        opts.colour_space_override = Some(ColourSpace::from_name(name).ok_or_else(|| {
-            invalid(
-                "--colour-space",
-                format!("expected lab, oklab, srgb-linear or srgb, found {name:?}"),
-            )
-        })?);
-    }
-    if let Some(name) = &args.gamut {
-        opts.gamut = GamutMapping::from_name(name).ok_or_else(|| {
-            invalid(
-                "--gamut",
-                format!("expected chroma or clip, found {name:?}"),
-            )
-        })?;
-    }
+    opts.colour_space_override = args.colour_space.map(Into::into);
+    opts.gamut = args.gamut.into();
     opts.reference = args.reference;
     opts.level = args.level;
     opts.dither = !args.no_dither;

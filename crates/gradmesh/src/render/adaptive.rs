@@ -15,10 +15,9 @@
 //!    share bit-identical vertices. A face coarser than an edge fans the boundary cells
 //!    along it out to the edge's extra samples (from a cell corner off the edge, or from the
 //!    face's centre when it is a single cell), so no T-junction is left: the snapped,
-//!    top-left-rule rasteriser sees the same edges from both sides, without cracks. Before
-//!    2026-12 every face took the count of its finest edge; this keeps each face nearer its
-//!    own density (Tucan's densest layer 36k cells instead of 52k, Glasses 77k instead of
-//!    102k at 1024 px).
+//!    top-left-rule rasteriser sees the same edges from both sides, without cracks. Each face
+//!    thus keeps its own density instead of taking the count of its finest edge, which would
+//!    spread a fine spot's cells over its neighbours.
 //! 3. **Triangles.** Two per cell (fans along finer edges), faces in order, cells in the order
 //!    (and with the diagonals) of the quads uniform refinement would make of the face, so
 //!    folds overlap the same way.
@@ -51,22 +50,21 @@ pub(crate) const BASE_LEVEL: usize = 3;
 const DEEPEST_BASE_LEVEL: usize = 4;
 /// Dense meshes start shallower when level [`BASE_LEVEL`] would have fewer pixels than this
 /// per face: building every face's patch then costs more than the pixels, and each face's own
-/// grid refines it where the picture needs it anyway. 64 since 2026-12 (16 before): with
-/// quadratic colour and the floor on counted cell sizes, Glasses.off and Tucan's densest layer
-/// at 1024 px start at level 2, take fewer triangles (Glasses 32k -> 22k) and plan faster,
-/// though their folds take more cells (each coarse face refines to its worst spot).
+/// grid refines it where the picture needs it anyway. With quadratic colour and the floor on
+/// counted cell sizes, dense layers such as Glasses.off at 1024 px then start at level 2 and
+/// take fewer triangles, though their folds take more cells (each coarse face refines to its
+/// worst spot).
 const MIN_BASE_FACE_PIXELS: usize = 64;
 
 /// Quadratic colour is tried on a face only while its linear error is at most this many times
-/// the tolerance. Found on the real artwork: at 16 the quarter points missed an error of 0.85
-/// Delta E at a steep edge of Glasses.off at 160 px (the accuracy test allows 0.5); at 8 the
-/// worst is 0.40 there, and the `vs_cairo` scene takes 2.7k cells instead of 1.6k (26.6k
-/// linear).
+/// the tolerance: with larger errors the quarter points that check it can miss a steep colour
+/// edge (Glasses.off at 160 px fails the accuracy test at twice this value), and quadratic
+/// faces still take far fewer cells than linear ones.
 const QUADRATIC_MAX_LINEAR_ERROR: f64 = 8.0;
 
 /// The slowest that linear pieces' colour error is taken to fall per level for a face that
-/// does not fold but may border one: where the surface folds, about 0.6 was seen (the floor
-/// on counted cell sizes, seventh round of `docs/performance-history.md`); elsewhere it quarters.
+/// does not fold but may border one: where the surface folds, about 0.6 is seen (see
+/// `ADAPTIVE_MIN_COUNTED_PX` in `measure.rs`); elsewhere it quarters.
 const LINEAR_RATE_NEAR_FOLDS: f64 = 0.6;
 
 /// The base level for a layer that can cover `pixels` pixels ([`covered_pixels`]):
@@ -318,7 +316,7 @@ fn measure_grid(
     };
     // Spaces whose distances are not Lab's measure through the derivative at each cell's
     // centre (as the quadratic measure does): one conversion per cell instead of two per
-    // comparison. (One per sample cost the `vs_cairo` scene, in sRGB, 5 % of its instructions.)
+    // comparison.
     jacobians.clear();
     let jacobians = needs_jacobians(th.space).then(|| {
         jacobians.extend(g2.iter().enumerate().map(|(k, d)| {
@@ -456,8 +454,7 @@ struct DrawnFaces {
 
 /// Faces whose triangles are built (and kept) together, in face order: a fixed number, so
 /// that the blocks of two preparations of a layer match. Small, because an edit builds every
-/// block it reaches again: moving a point of Tucan's densest layer took 9 % more instructions
-/// with blocks of 64 faces, and a render from scratch is the same with either.
+/// block it reaches again; a render from scratch does not depend on the block size.
 const FACES_PER_BLOCK: usize = 16;
 
 /// Which blocks of `per_block` faces (in face order) must build their triangles again: those
@@ -886,7 +883,7 @@ pub(super) fn tessellate(
     // face then fans its boundary cells out to the edge's extra samples (step 3).
     let edge_counts = |plans: &[Arc<Plan>]| -> Vec<usize> {
         // The counts side by side first: read through each plan's pointer, edge by edge, they
-        // were a cache miss each (for 90,000 faces, 5 ms on one core).
+        // would be a cache miss each.
         let counts: Vec<usize> = plans.par_iter().map(|p| p.n).collect();
         (0..t.edge_count())
             .into_par_iter()

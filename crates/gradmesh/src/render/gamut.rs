@@ -265,7 +265,7 @@ pub(crate) struct RunConverter {
 impl RunConverter {
     /// `branch_free`: encode for the blend space with [`srgb_encode_unit_f32`] over the whole
     /// run rather than colour by colour (same bits). Faster where the code is compiled for
-    /// AVX2 (Tucan at 4096 px: 119 -> 115 ms), slower on the x86-64 baseline (146 -> 155 ms).
+    /// AVX2, slower on the x86-64 baseline.
     pub fn new(
         space: ColourSpace,
         gamut: GamutMapping,
@@ -355,8 +355,7 @@ impl RunConverter {
     #[inline(always)]
     fn convert_outside(&self, c: &[[f32; RUN]; 3], indices: &[u8], out: &mut [[f32; 3]; RUN]) {
         // Wide groups where there are many colours (sixteen lanes overlap the search's chains
-        // of divisions best: a grid half outside the gamut drew in 76 ms, against 85 with
-        // eight lanes and 91 with four), narrow ones for the few left.
+        // of divisions better than eight or four), narrow ones for the few left.
         let mut wide = indices.chunks_exact(GAMUT_LANES);
         for group in &mut wide {
             self.convert_outside_group::<GAMUT_LANES>(c, group, out);

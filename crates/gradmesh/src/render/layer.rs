@@ -495,7 +495,7 @@ pub(crate) fn prepare(
     let original_space = mesh.colour_space;
     let mesh = in_space(mesh, space);
     // Level 1 only: the fast path of a dense layer starts there, and each path builds the
-    // levels it needs (level 2 of a 10,000-face mesh alone took about 100 ms). An edited layer
+    // levels it needs (level 2 of a dense mesh is costly and often not needed). An edited layer
     // whose topology stayed takes the levels its last preparation built.
     let (base, warnings) = BaseMesh::new(&mesh).map_err(|e| e.in_layer(index))?;
     if let Some(forced) = opts.level {

@@ -16,17 +16,16 @@ use super::{each3, each4, RenderOptions};
 pub(super) const MIN_QUAD_PX: f64 = 1.0;
 /// ...and in smaller cells of the fast path's faces that hold a pixel centre, down to this
 /// size. Where the surface folds, the colour error of linear pieces only falls by about 0.6 a
-/// level (the map to the screen is singular at the crease), and without a floor one spot of
-/// Glasses.off took faces of 64 x 64 cells of 0.09 pixels (2026-12: 40k cells at 1024 px,
-/// 25k with this floor; the accuracy test's figures did not move). At 0.35 the test failed
-/// (0.54 on Glasses at 160 px), at 0.5 badly (9.2, which sheet shows at a Tucan fold).
+/// level (the map to the screen is singular at the crease), and without a floor a fold can
+/// take faces of thousands of cells under a tenth of a pixel. The floor is the largest the
+/// accuracy tests against the reference mode allow: larger ones miss colour errors at folds
+/// (which sheet shows there).
 const ADAPTIVE_MIN_COUNTED_PX: f64 = 0.2;
 /// The fast path holds each face's measured colour error to this fraction of the tolerance: the
-/// measure samples cell and side centres only, and each face now stops right at the threshold
+/// measure samples cell and side centres only, and each face stops right at the threshold
 /// instead of at the level the worst spot of the layer asks for (the uniform path's margin).
-/// Half (before 2026-12) cost about twice the cells for the same pictures: against the
-/// reference mode the worst pixel of every example and real file stayed below 0.3 CIEDE2000
-/// but one (0.43, on a one-pixel colour crease), the worst mean 0.022 (limits 0.5 and 0.05).
+/// A smaller fraction costs more cells for pictures that the accuracy tests against the
+/// reference mode cannot tell apart (limits 0.5 worst and 0.05 mean CIEDE2000).
 const ADAPTIVE_COLOUR_MARGIN: f64 = 0.75;
 /// What the fast path asks of the triangles (the reference mode has its own, stricter ones).
 pub(super) struct Thresholds {

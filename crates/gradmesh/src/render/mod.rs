@@ -164,9 +164,8 @@ pub struct RenderOptions {
     pub colour_tolerance: f64,
     /// Largest diagonal, in pixels, of a refined quad that reaches the image (default 64): keeps
     /// the colour measurement's samples dense. The colour measure does not depend on the image
-    /// size, so this cap is what makes large images need more quads: at 16 it drove the
-    /// quad count at 4096 px (Tucan's largest layer: 531k quads instead of 59k), for no
-    /// difference the accuracy tests could see.
+    /// size, so this cap is what makes large images need more quads: a smaller cap multiplies
+    /// the quads of large images for no difference the accuracy tests can see.
     pub max_quad_px: f64,
     /// Slow and simple: colours within 0.002 (about Delta E, counted in quads from 0.1 pixel
     /// across) and quads under half a pixel; outline flattened to 0.0002 px. One more level changes no 16-bit
@@ -193,7 +192,7 @@ pub struct RenderOptions {
     pub max_pixels: u64,
     /// Let the fast path interpolate colour quadratically over the triangles of faces where
     /// that passes the colour tolerance with fewer cells than linear colour (default `true`).
-    /// `false` draws every face with linear colour, as before 2026-12.
+    /// `false` draws every face with linear colour (more triangles), for comparison.
     pub quadratic: bool,
 }
 
@@ -873,8 +872,7 @@ fn draw_band_dispatched<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
 }
 
 /// [`draw_band`] for the baseline CPU.
-// Not inlined into the rayon closure: inlined there, its loops were compiled worse (7 % more
-// instructions for the `vs_cairo` scene, seen with callgrind).
+// Not inlined into the rayon closure: inlined there, its loops compile worse.
 #[inline(never)]
 fn draw_band_baseline<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
     draw_band(job, s)
@@ -1105,7 +1103,7 @@ fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
                 colour,
             };
             // Separate loops for the first layer, which has nothing to test and nothing to
-            // read: the tests cost the `vs_cairo` scene a tenth of its drawing instructions.
+            // read: the tests are a noticeable share of drawing.
             opaque += if fresh {
                 shade_row::<true>(a..b, coverage, y, band, &nearest, &shading)
             } else {
@@ -1385,7 +1383,7 @@ fn shade_row<const FRESH: bool>(
         }
     } else {
         // Pixel by pixel: the other spaces have no vector path, and gathering them into runs
-        // cost the sRGB `vs_cairo` scene 4 % more instructions.
+        // costs more than it saves.
         let (gamut, blend) = (shading.gamut, shading.blend);
         if shading.rarely_outside {
             // Colours in range need nothing (SVG's, Cairo's), and the search below cost the
