@@ -2,7 +2,7 @@
 //! write and read back, validation and a small refinement.
 #![no_main]
 
-#[path = "../../crates/gradmesh/tests/fuzz_entry/mod.rs"]
+#[path = "../../crates/gradmesh/tests/integration/fuzz_entry/mod.rs"]
 mod fuzz_entry;
 
 libfuzzer_sys::fuzz_target!(|data: &[u8]| {

@@ -4,7 +4,7 @@
 //! written and in range, the cached render equals a fresh one, one thread equals two.
 #![no_main]
 
-#[path = "../../crates/gradmesh/tests/fuzz_entry/mod.rs"]
+#[path = "../../crates/gradmesh/tests/integration/fuzz_entry/mod.rs"]
 mod fuzz_entry;
 
 libfuzzer_sys::fuzz_target!(|desc: fuzz_entry::render::RenderDescription| {

@@ -2,8 +2,8 @@
 //! wide, in f32 (finer than 16-bit output, so rounding hides nothing): at most 0.5 CIEDE2000 on
 //! any pixel at least two pixels inside the outline, at most 0.05 on average.
 //!
-//! Slow (about two minutes in release mode): `cargo test --release --test accuracy_1024 --
-//! --ignored --nocapture` prints the figures of each file.
+//! Slow (about two minutes in release mode): `cargo test --release -p gradmesh --test integration
+//! accuracy_1024 -- --ignored --nocapture` prints the figures of each file.
 
 use std::path::{Path, PathBuf};
 
@@ -40,10 +40,7 @@ fn inside(img: &Image, x: i64, y: i64, margin: i64) -> bool {
 fn inputs() -> Vec<(String, Vec<PathBuf>)> {
     let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."));
     let mut out = Vec::new();
-    for dir in [
-        root.join("examples"),
-        root.join("../shared/realdata/gradientmeshimproved-off"),
-    ] {
+    for dir in [root.join("examples"), crate::realdata::dir()] {
         let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
             .unwrap()
             .map(|e| e.unwrap().path())

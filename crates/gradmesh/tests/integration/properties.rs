@@ -1,8 +1,6 @@
 //! Property tests of the paper's conditions on random valid meshes of mixed face sizes.
 
-mod common;
-
-use common::{build, mesh_spec};
+use crate::common::{build, mesh_spec};
 use gradmesh::refine::{RefinedMesh, Refinement};
 use gradmesh::GradientMesh;
 use kurbo::{Affine, Point, Vec2};

@@ -6,8 +6,8 @@
 //! limits, all numbers finite), and render the document at one pixel per unit. None may panic.
 //! Messages are compared with the corpus directory stripped, as `name.json:3: ...`.
 //!
-//! `GRADMESH_BLESS=1 cargo test --test corpus` writes the current messages into missing
-//! sidecars (review them before committing).
+//! `GRADMESH_BLESS=1 cargo test --test integration corpus::` writes the current messages into
+//! missing sidecars (review them before committing).
 
 use std::fs;
 use std::panic::{catch_unwind, AssertUnwindSafe};

@@ -1,4 +1,4 @@
-//! Random valid meshes for property tests: shared by several test binaries.
+//! Random valid meshes for property tests: shared by several test modules.
 
 #![allow(dead_code)]
 

@@ -1,10 +1,10 @@
 //! Replays the committed, minimised fuzz corpus (`fuzz/seeds/<target>/`), the working corpus
 //! of a local fuzzing run (`fuzz/corpus/<target>/`, when present) and the regression files
 //! (`tests/regressions/<target>/`: inputs that once crashed a fuzz target) through the same entry
-//! points as the fuzz targets (`tests/fuzz_entry/mod.rs`), so that `cargo test` catches a
-//! regression without cargo-fuzz.
+//! points as the fuzz targets (`tests/integration/fuzz_entry/mod.rs`), so that `cargo test`
+//! catches a regression without cargo-fuzz.
 
-mod fuzz_entry;
+use crate::fuzz_entry;
 
 use std::fs;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -70,7 +70,7 @@ fn fuzz_corpus_and_regressions_replay_cleanly() {
 
 #[test]
 fn sample_descriptions_run() {
-    use fuzz_entry::{MeshDescription, Scale, Shape};
+    use crate::fuzz_entry::{MeshDescription, Scale, Shape};
     let base = MeshDescription {
         shape: Shape::Grid {
             w: 2,

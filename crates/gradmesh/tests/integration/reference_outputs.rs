@@ -5,20 +5,13 @@
 //! matched by position and compared at the printed precision; faces are compared as cycles of
 //! matched vertices.
 
-use std::path::PathBuf;
-
 use gradmesh::formats::off::read_off;
 use gradmesh::refine::Refinement;
 use gradmesh::topology::Topology;
 use gradmesh::validate::VertexData;
 use gradmesh::GradientMesh;
 
-fn realdata() -> PathBuf {
-    PathBuf::from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/realdata/gradientmeshimproved-off"
-    ))
-}
+use crate::realdata;
 
 struct Reference {
     points: Vec<[f64; 5]>,
@@ -27,7 +20,8 @@ struct Reference {
 
 /// Reads a reference output: `OFF`, `nV nF 0`, `x y z L a b 0 0` lines, `n i0 .. i(n-1)` lines.
 fn read_reference(name: &str) -> Reference {
-    let text = std::fs::read_to_string(realdata().join("reference-output").join(name)).unwrap();
+    let text =
+        std::fs::read_to_string(realdata::path(&format!("reference-output/{name}"))).unwrap();
     let mut lines = text.lines().filter(|l| !l.trim().is_empty());
     assert_eq!(lines.next().unwrap().trim(), "OFF");
     let counts: Vec<usize> = lines
@@ -53,7 +47,7 @@ fn read_reference(name: &str) -> Reference {
 }
 
 fn load(name: &str) -> GradientMesh {
-    let text = std::fs::read_to_string(realdata().join(name)).unwrap();
+    let text = std::fs::read_to_string(realdata::path(name)).unwrap();
     read_off(&text).unwrap()
 }
 

@@ -2,9 +2,7 @@
 //! ternary step. Conditions 1 and 2, topology, the regular split of a grid, the file option,
 //! interpolated positions, and how close the result is to the ternary step's.
 
-mod common;
-
-use common::{build, mesh_spec};
+use crate::common::{build, mesh_spec};
 use gradmesh::binary_step::{edge_midpoint, face_centre, inner_point, HANDLE_SCALE};
 use gradmesh::formats::{json, off::read_off};
 use gradmesh::refine::{RefinedMesh, Refinement};
@@ -45,11 +43,7 @@ fn colour_bounds(mesh: &GradientMesh) -> ([f64; 4], [f64; 4]) {
 }
 
 fn realdata(name: &str) -> GradientMesh {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/realdata/gradientmeshimproved-off/"
-    );
-    read_off(&std::fs::read_to_string(format!("{path}{name}")).unwrap()).unwrap()
+    read_off(&std::fs::read_to_string(crate::realdata::path(name)).unwrap()).unwrap()
 }
 
 const REAL_FILES: [&str; 6] = [
@@ -584,13 +578,10 @@ fn the_binary_step_looks_like_the_ternary_step() {
         ("grid, short handles".to_string(), grid(4, Some(0.2)), 0.5),
         ("grid, long handles".to_string(), grid(4, Some(0.45)), 0.7),
     ];
-    for name in std::fs::read_dir(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/realdata/gradientmeshimproved-off/"
-    ))
-    .unwrap()
-    .map(|e| e.unwrap().file_name().into_string().unwrap())
-    .filter(|n| n.ends_with(".off"))
+    for name in std::fs::read_dir(crate::realdata::dir())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n.ends_with(".off"))
     {
         meshes.push((name.clone(), realdata(&name), 0.5));
     }

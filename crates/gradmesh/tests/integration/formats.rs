@@ -7,12 +7,7 @@ use std::path::{Path, PathBuf};
 use gradmesh::formats::{self, json, obj, off, Format};
 use gradmesh::{validate, ColourSpace, Document, EdgeKind, ErrorKind};
 
-fn realdata() -> PathBuf {
-    PathBuf::from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/realdata/gradientmeshimproved-off"
-    ))
-}
+use crate::realdata;
 
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -44,7 +39,7 @@ fn assert_round_trip(doc: &Document, what: &str) {
 
 #[test]
 fn every_real_off_file_loads_and_validates() {
-    let files = files_with_extension(&realdata(), "off");
+    let files = files_with_extension(&realdata::dir(), "off");
     assert!(
         files.len() >= 11,
         "expected the 11 artwork files, found {files:?}"
@@ -91,7 +86,7 @@ fn every_real_off_file_loads_and_validates() {
 #[test]
 fn the_authors_refined_outputs_load_as_meshes_too() {
     // Their output lines `x y z L a b 0 0` are vertex lines without neighbours.
-    for path in files_with_extension(&realdata().join("reference-output"), "off") {
+    for path in files_with_extension(&realdata::path("reference-output"), "off") {
         let doc = formats::read_path(&path).unwrap_or_else(|e| panic!("{e}"));
         let mesh = &doc.layers[0];
         assert!(mesh.handles.is_empty());

@@ -1,6 +1,7 @@
 //! Entry points shared by the fuzz targets (`fuzz/fuzz_targets/*.rs` include this file with
-//! `#[path]`) and by `tests/fuzz_replay.rs`, which replays the fuzz corpus and the regression
-//! files through the same functions in a normal `cargo test`.
+//! `#[path]`) and by `tests/integration/fuzz_replay.rs`, which replays the fuzz corpus and the
+//! regression files through the same functions in a normal `cargo test`. Included standalone by
+//! the fuzz targets, it uses no other module of the integration tests.
 //!
 //! Each entry point takes any input and panics only when the library misbehaves: a panic inside
 //! the library, a non-finite number in refined or limit data, a colour that the limit surface

@@ -1,8 +1,6 @@
 //! The paper's options (section 4.5): interpolating geometry.
 
-mod common;
-
-use common::{build, mesh_spec};
+use crate::common::{build, mesh_spec};
 use gradmesh::formats::{json, off::read_off};
 use gradmesh::refine::Refinement;
 use gradmesh::{EdgeKind, GradientMesh};
@@ -30,11 +28,7 @@ fn interpolation_error(mesh: &GradientMesh, depth: usize) -> f64 {
 }
 
 fn realdata(name: &str) -> GradientMesh {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/realdata/gradientmeshimproved-off/"
-    );
-    read_off(&std::fs::read_to_string(format!("{path}{name}")).unwrap()).unwrap()
+    read_off(&std::fs::read_to_string(crate::realdata::path(name)).unwrap()).unwrap()
 }
 
 #[test]

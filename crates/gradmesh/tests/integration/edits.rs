@@ -1,6 +1,6 @@
 //! Multi-resolution edits: addressing, exactness, locality, following coarse edits, round trips.
 
-mod common;
+use crate::common;
 
 use gradmesh::formats::json::{read_document, write_document};
 use gradmesh::render::{render_document, RenderOptions, View};

@@ -4,14 +4,16 @@
 //! * A pixel passes when every channel is within `TOLERANCE` of the reference (8-bit units);
 //!   the test fails if any pixel does not, and writes `target/reference-diffs/<name>.png`
 //!   (expected | difference | actual) to look at.
-//! * `GRADMESH_BLESS=1 cargo test --test reference_images` rewrites the references from the
-//!   current renderer. Look at them before committing.
+//! * `GRADMESH_BLESS=1 cargo test --test integration reference_images` rewrites the references
+//!   from the current renderer. Look at them before committing.
 
 use std::path::{Path, PathBuf};
 
 use gradmesh::formats::read_path;
 use gradmesh::render::{render_document, Image, RenderOptions};
 use gradmesh::Document;
+
+use crate::realdata;
 
 /// Largest difference per channel, in 8-bit units, between a rendering and its reference.
 const TOLERANCE: u8 = 2;
@@ -116,10 +118,10 @@ fn example(name: &str) {
 }
 
 fn real(name: &str, files: &[&str]) {
-    let dir = repo().join("../shared/realdata/gradientmeshimproved-off");
     let mut doc = Document::default();
     for f in files {
-        doc.layers.extend(read_path(&dir.join(f)).unwrap().layers);
+        doc.layers
+            .extend(read_path(&realdata::path(f)).unwrap().layers);
     }
     check(name, &doc);
 }

@@ -1,7 +1,8 @@
 //! `docs/errors.md` lists every error with an example input and the message it gives. The
 //! table is generated here by running each example, and must equal the one in the document, so
-//! that the document cannot drift from the code: `GRADMESH_BLESS=1 cargo test --test
-//! errors_doc` rewrites it. Every variant of `ErrorKind` (read from `src/error.rs`) must appear.
+//! that the document cannot drift from the code: `GRADMESH_BLESS=1 cargo test -p gradmesh --test
+//! integration errors_doc` rewrites it. Every variant of `ErrorKind` (read from `src/error.rs`)
+//! must appear.
 
 use std::fs;
 use std::path::Path;
@@ -12,7 +13,7 @@ use gradmesh::render::{render_document, RenderOptions, View};
 use gradmesh::{ColourSpace, Document, EdgeKind, Error, GradientMesh, Limits};
 use kurbo::{Point, Vec2};
 
-const BEGIN: &str = "<!-- BEGIN GENERATED TABLE: tests/errors_doc.rs -->";
+const BEGIN: &str = "<!-- BEGIN GENERATED TABLE: tests/integration/errors_doc.rs -->";
 const END: &str = "<!-- END GENERATED TABLE -->";
 
 /// A JSON document with one layer made of `points` (objects), `faces` and extra fields.
@@ -443,7 +444,7 @@ fn the_error_table_is_up_to_date() {
             fs::write(&path, new).unwrap();
         } else {
             panic!(
-                "docs/errors.md is out of date; run GRADMESH_BLESS=1 cargo test --test errors_doc\n{generated}"
+                "docs/errors.md is out of date; run GRADMESH_BLESS=1 cargo test -p gradmesh --test integration errors_doc\n{generated}"
             );
         }
     }

@@ -9,9 +9,7 @@
 //! when computed one level deeper; `limit::tests::dart_mask_is_the_limit_of_refinement`), and
 //! gradmesh uses the exact mask.
 
-mod common;
-
-use common::{build, mesh_spec};
+use crate::common::{build, mesh_spec};
 use gradmesh::catmull_clark::{self, Level};
 use gradmesh::limit::limit_stencils;
 use gradmesh::mesh::SHARPNESS_INFINITE;

@@ -3,16 +3,12 @@
 //! Also: the last level's data computed without the stencil table (`refine_data`, used by
 //! `gradmesh refine`) equals applying the table.
 
-use std::path::Path;
-
 use gradmesh::catmull_clark;
 use gradmesh::formats::{self, obj};
 use gradmesh::refine::Refinement;
 use gradmesh::validate::VertexData;
 use gradmesh::{ColourSpace, EdgeKind, GradientMesh};
 use kurbo::{Point, Vec2};
-
-const REAL: &str = "/work/shared/realdata/gradientmeshimproved-off/Glasses.off";
 
 /// Every level's data (as bits) and the OBJ of the deepest level.
 fn run(mesh: &GradientMesh, depth: usize) -> (Vec<Vec<[u64; 6]>>, String) {
@@ -90,11 +86,7 @@ fn generated_mesh_is_thread_independent() {
 
 #[test]
 fn real_file_is_thread_independent() {
-    if !Path::new(REAL).exists() {
-        eprintln!("skipped: {REAL} is not on this machine");
-        return;
-    }
-    let doc = formats::read_path(Path::new(REAL)).unwrap();
+    let doc = formats::read_path(&crate::realdata::path("Glasses.off")).unwrap();
     for mesh in &doc.layers {
         assert_thread_independent(mesh, 4);
     }

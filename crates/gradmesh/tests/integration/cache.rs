@@ -10,17 +10,15 @@ use gradmesh::render::{
 };
 use gradmesh::{ColourSpace, Document};
 
+use crate::realdata;
+
 /// The six layers of the authors' Tucan, bottom to top.
 fn tucan() -> Document {
-    let dir = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/realdata/gradientmeshimproved-off/"
-    );
     let layers = (0..6)
         .rev()
         .map(|i| {
-            let path = format!("{dir}Tucan_Tucan_Layer{i}.off");
-            let mut doc = read_path(std::path::Path::new(&path)).unwrap();
+            let path = realdata::path(&format!("Tucan_Tucan_Layer{i}.off"));
+            let mut doc = read_path(&path).unwrap();
             doc.layers.remove(0)
         })
         .collect();

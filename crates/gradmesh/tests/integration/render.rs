@@ -13,6 +13,8 @@ use kurbo::{Point, Vec2};
 use palette::color_difference::Ciede2000;
 use palette::{white_point::D65, Lab};
 
+use crate::realdata;
+
 // ---------------------------------------------------------------------------------------------
 // Meshes
 
@@ -333,15 +335,10 @@ fn adaptive_path_has_no_cracks() {
 /// several layers, faces of many densities.
 #[test]
 fn deterministic_with_default_pool() {
-    let dir = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/realdata/gradientmeshimproved-off"
-    );
     let mut layers = Vec::new();
     for name in ["Tucan_Tucan_Layer3", "Tucan_Tucan_Layer1"] {
-        if let Ok(text) = std::fs::read_to_string(format!("{dir}/{name}.off")) {
-            layers.push(gradmesh::formats::off::read_off(&text).unwrap());
-        }
+        let text = std::fs::read_to_string(realdata::path(&format!("{name}.off"))).unwrap();
+        layers.push(gradmesh::formats::off::read_off(&text).unwrap());
     }
     layers.extend(featured_meshes().into_iter().map(|(_, m)| m));
     let d = doc(layers);
@@ -846,20 +843,12 @@ fn outlines_are_drawn_on_top() {
 /// large enough that the shortest handles (under a unit in this artwork) span a pixel or so.
 #[test]
 fn real_artwork() {
-    let dir = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/realdata/gradientmeshimproved-off"
-    );
     for name in [
         "Paprika_Paprika_layer0",
         "Tucan_Tucan_Layer3",
         "Tucan_Tucan_Layer1",
     ] {
-        let path = format!("{dir}/{name}.off");
-        let Ok(text) = std::fs::read_to_string(&path) else {
-            eprintln!("{path} not found: skipped");
-            continue;
-        };
+        let text = std::fs::read_to_string(realdata::path(&format!("{name}.off"))).unwrap();
         let mesh = gradmesh::formats::off::read_off(&text).unwrap();
         let d = doc(vec![mesh.clone()]);
 
