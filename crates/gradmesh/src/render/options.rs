@@ -1,0 +1,219 @@
+//! How to render: the options, their defaults and the limits they are checked against.
+
+use crate::error::{Error, ErrorKind};
+use crate::mesh::Document;
+
+use super::gamut::{BlendSpace, GamutMapping};
+use super::view::View;
+use crate::colour::ColourSpace;
+
+/// The largest image side accepted.
+pub const MAX_SIDE: u32 = 1 << 15;
+/// The default largest pixel count ([`RenderOptions::max_pixels`]): 100 megapixels.
+pub const MAX_PIXELS: u64 = 100_000_000;
+/// The largest magnitude of a view's coordinates: that of a mesh's
+/// ([`crate::validate::MAX_MAGNITUDE`]).
+pub const MAX_VIEW_MAGNITUDE: f64 = crate::validate::MAX_MAGNITUDE;
+/// The smallest pixel, in plane units: a mesh's shortest edge
+/// ([`crate::validate::MIN_EDGE_LENGTH`]).
+pub const MIN_PIXEL_SIZE: f64 = crate::validate::MIN_EDGE_LENGTH;
+/// The smallest pixel relative to the view's largest coordinate (2^-32): smaller pixels leave
+/// too few bits of a coordinate to place anti-aliased edges within them.
+pub const MIN_RELATIVE_PIXEL_SIZE: f64 = 1.0 / 4_294_967_296.0;
+
+/// How to render a document.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderOptions {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// The rectangle of the plane mapped onto the image.
+    pub view: View,
+    /// What lies under the first layer: non-linear sRGB and alpha in `0..=1`, straight alpha.
+    /// `None` is transparent.
+    pub background: Option<[f64; 4]>,
+    /// Largest distance, in pixels, between the outline (drawn exactly) and the boundary edges of
+    /// the triangles (default 0.25). Outline pixels between the two take the colour of the
+    /// nearest boundary point.
+    pub tolerance_px: f64,
+    /// Largest colour error of the triangles against the limit surface, approximately in Delta E
+    /// (CIE Lab units), measured at quad and edge centres (default 0.2).
+    pub colour_tolerance: f64,
+    /// Largest diagonal, in pixels, of a refined quad that reaches the image (default 64): keeps
+    /// the colour measurement's samples dense. The colour measure does not depend on the image
+    /// size, so this cap is what makes large images need more quads: a smaller cap multiplies
+    /// the quads of large images for no difference the accuracy tests can see.
+    pub max_quad_px: f64,
+    /// Slow and simple: colours within 0.002 (about Delta E, counted in quads from 0.1 pixel
+    /// across) and quads under half a pixel; outline flattened to 0.0002 px. One more level changes no 16-bit
+    /// channel of the test meshes by more than one step (see the tests). Still bounded by
+    /// [`RenderOptions::max_quads`](super::RenderOptions::max_quads): keep reference images small.
+    pub reference: bool,
+    /// Use this refinement level (at least 2) instead of choosing one.
+    pub level: Option<usize>,
+    /// The deepest level ever chosen (default 10).
+    pub max_level: usize,
+    /// Most quads in any level built (default 2^21: about 1.2 GB at the peak, refinement tables
+    /// of every level included); the level stops below it and [`LayerInfo::capped`](super::LayerInfo::capped) says so.
+    pub max_quads: usize,
+    /// Interpolate in this space instead of each mesh's own (control colours are converted).
+    pub colour_space_override: Option<ColourSpace>,
+    /// What to do with colours outside the sRGB gamut.
+    pub gamut: GamutMapping,
+    /// Where layers are composited.
+    pub blend: BlendSpace,
+    /// Dither 8-bit output of [`render_document_into`](super::render_document_into) (deterministic triangular noise).
+    pub dither: bool,
+    /// The largest image accepted, in pixels (default [`MAX_PIXELS`]): a larger request is
+    /// refused before anything is allocated.
+    pub max_pixels: u64,
+    /// Let the fast path interpolate colour quadratically over the triangles of faces where
+    /// that passes the colour tolerance with fewer cells than linear colour (default `true`).
+    /// `false` draws every face with linear colour (more triangles), for comparison.
+    pub quadratic: bool,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            width: 256,
+            height: 256,
+            view: View::default(),
+            background: None,
+            tolerance_px: 0.25,
+            colour_tolerance: 0.2,
+            max_quad_px: 64.0,
+            reference: false,
+            level: None,
+            max_level: 10,
+            max_quads: 1 << 21,
+            colour_space_override: None,
+            gamut: GamutMapping::default(),
+            blend: BlendSpace::default(),
+            dither: true,
+            max_pixels: MAX_PIXELS,
+            quadratic: true,
+        }
+    }
+}
+
+impl RenderOptions {
+    /// Options for a `width` x `height` image of `view`, other fields at their defaults.
+    pub fn new(width: u32, height: u32, view: View) -> Self {
+        RenderOptions {
+            width,
+            height,
+            view,
+            ..RenderOptions::default()
+        }
+    }
+
+    /// Options showing the whole document ([`View::fit`] with a 2% margin) in an image whose
+    /// larger side is `max_side` pixels, with the document's aspect ratio.
+    pub fn fit(doc: &Document, max_side: u32) -> Self {
+        let view = View::fit(doc, 0.02);
+        let (width, height) = view.size_for(max_side);
+        // Make the view's aspect exactly the image's, so pixels are square.
+        let scale = (view.width() / width as f64).max(view.height() / height as f64);
+        let (cx, cy) = (0.5 * (view.x0 + view.x1), 0.5 * (view.y0 + view.y1));
+        let (hw, hh) = (0.5 * scale * width as f64, 0.5 * scale * height as f64);
+        RenderOptions::new(width, height, View::new(cx - hw, cy - hh, cx + hw, cy + hh))
+    }
+
+    /// Refuses options that cannot be rendered: an empty image, a side above [`MAX_SIDE`], more
+    /// pixels than [`RenderOptions::max_pixels`], a view that is empty, not finite, beyond
+    /// ±[`MAX_VIEW_MAGNITUDE`] or whose pixels are smaller than its coordinates can resolve
+    /// ([`MIN_PIXEL_SIZE`], [`MIN_RELATIVE_PIXEL_SIZE`]), and tolerances or a background that
+    /// are not finite. (A forced [`RenderOptions::level`] is checked against
+    /// [`RenderOptions::max_quads`](super::RenderOptions::max_quads) for each layer, from its base mesh, before it is built.)
+    ///
+    /// Every render function calls it first, before allocating anything; a caller that
+    /// allocates its own output buffer for [`render_document_into`](super::render_document_into) calls it before that.
+    pub fn check(&self) -> Result<(), Error> {
+        let invalid = |what: &str, message: String| -> Error {
+            ErrorKind::Invalid {
+                what: what.into(),
+                message,
+            }
+            .into()
+        };
+        if self.width == 0 || self.height == 0 {
+            return Err(invalid(
+                "image size",
+                format!("{}x{} has no pixels", self.width, self.height),
+            ));
+        }
+        let pixels = self.width as u64 * self.height as u64;
+        if pixels > self.max_pixels {
+            return Err(ErrorKind::LimitExceeded {
+                what: "pixel count".into(),
+                found: pixels,
+                limit: self.max_pixels,
+            }
+            .into());
+        }
+        let side = self.width.max(self.height);
+        if side > MAX_SIDE {
+            return Err(ErrorKind::LimitExceeded {
+                what: "image side".into(),
+                found: side as u64,
+                limit: MAX_SIDE as u64,
+            }
+            .into());
+        }
+        self.check_view()?;
+        for (name, value) in [
+            ("tolerance", self.tolerance_px),
+            ("colour tolerance", self.colour_tolerance),
+            ("largest quad size", self.max_quad_px),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(invalid(name, format!("must be positive, not {value}")));
+            }
+        }
+        if let Some(bg) = self.background {
+            if bg.iter().any(|c| !c.is_finite()) {
+                return Err(invalid("background", format!("{bg:?} is not finite")));
+            }
+        }
+        Ok(())
+    }
+
+    /// Refuses a view that is empty or not finite, reaches beyond ±[`MAX_VIEW_MAGNITUDE`], or
+    /// whose pixels are smaller than [`MIN_PIXEL_SIZE`] or than [`MIN_RELATIVE_PIXEL_SIZE`]
+    /// times its largest coordinate (adjacent pixels would map to the same plane coordinates).
+    fn check_view(&self) -> Result<(), Error> {
+        let v = &self.view;
+        let corners = [v.x0, v.y0, v.x1, v.y1];
+        let shown = format!("({:?}, {:?}) to ({:?}, {:?})", v.x0, v.y0, v.x1, v.y1);
+        let invalid = |message: String| -> Error {
+            ErrorKind::Invalid {
+                what: "view".into(),
+                message: format!("{shown}: {message}"),
+            }
+            .into()
+        };
+        if !corners.iter().all(|x| x.is_finite()) {
+            return Err(invalid("every coordinate must be a finite number".into()));
+        }
+        let largest = corners.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if largest > MAX_VIEW_MAGNITUDE {
+            return Err(invalid(format!(
+                "a coordinate is beyond ±{MAX_VIEW_MAGNITUDE:e}, the largest a mesh may have"
+            )));
+        }
+        if !(v.width() > 0.0 && v.height() > 0.0) {
+            return Err(invalid("x1 must exceed x0 and y1 must exceed y0".into()));
+        }
+        let pixel = (v.width() / self.width as f64).min(v.height() / self.height as f64);
+        let smallest = MIN_PIXEL_SIZE.max(MIN_RELATIVE_PIXEL_SIZE * largest);
+        if pixel < smallest {
+            return Err(invalid(format!(
+                "a pixel would be {pixel:e} units across, below the {smallest:e} that \
+                 coordinates of this size resolve"
+            )));
+        }
+        Ok(())
+    }
+}
