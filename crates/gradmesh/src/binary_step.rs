@@ -33,7 +33,7 @@
 
 use kurbo::{Point, Vec2};
 
-use crate::catmull_clark::Level;
+use crate::level::Level;
 use crate::ternary_step::{edge_point, face_point, face_point_position};
 use crate::topology::Topology;
 use crate::validate::{BaseMesh, VertexData};

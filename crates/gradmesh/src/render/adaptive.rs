@@ -26,8 +26,8 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use rayon::prelude::*;
 
-use crate::catmull_clark::Level;
 use crate::colour::{ColourSpace, Matrix3};
+use crate::level::Level;
 use crate::refine::{RefinedMesh, Refinement};
 use crate::rules;
 use crate::topology::Topology;

@@ -14,7 +14,7 @@
 
 use std::collections::HashMap;
 
-use crate::catmull_clark::Level;
+use crate::level::Level;
 use crate::rules::VertexRule;
 use crate::topology::Topology;
 

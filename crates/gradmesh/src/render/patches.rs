@@ -17,7 +17,8 @@
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
 
-use crate::catmull_clark::{self, Level, Stencils};
+use crate::catmull_clark::{self, Stencils};
+use crate::level::Level;
 use crate::limit;
 use crate::mesh::{BoundaryInterpolation, CreasingMethod};
 use crate::rules::{self, VertexRule};
