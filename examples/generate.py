@@ -3,7 +3,7 @@
 
 Each example shows one thing the paper shows; the figure numbers refer to Lieng et al. 2017.
 Run from the repository root: python3 examples/generate.py, then write each file in the
-canonical layout (tests/formats.rs checks that reading and writing an example changes no byte):
+canonical layout (tests/integration/formats.rs checks that reading and writing an example changes no byte):
 for f in examples/*.json; do cargo run -q -p gradmesh-cli -- convert --force "$f" -o "$f"; done
 """
 import json
