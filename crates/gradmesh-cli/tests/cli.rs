@@ -569,15 +569,15 @@ fn absurd_images_are_refused_before_anything_is_allocated() {
     render(
         &["--width", "100", "--level", "40"],
         &[
-            "Glasses.off: layer 0: the number of quads of refinement level 40",
+            "Glasses.off: layer 0: the number of faces of refinement level",
             "limit of 2,097,152",
         ],
     );
-    // A level within max_level whose quads would exceed max_quads is refused from an estimate.
+    // A level whose quads would exceed max_quads is refused from an estimate.
     render(
         &["--width", "100", "--level", "9"],
         &[
-            "Glasses.off: layer 0: the number of quads of refinement level 9",
+            "Glasses.off: layer 0: the number of faces of refinement level 9",
             "limit of 2,097,152",
         ],
     );

@@ -6,7 +6,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::colour::ColourSpace;
-use crate::error::{Error, ErrorKind, Warning};
+use crate::error::{Error, Warning};
 use crate::limit;
 use crate::limits::Limits;
 use crate::mesh::GradientMesh;
@@ -270,23 +270,6 @@ fn forced_level(base: &BaseMesh, forced: usize) -> usize {
     forced.max(2).max(base.edits.deepest_level() + 1)
 }
 
-/// Refuses a forced level whose quads, estimated from the base mesh before anything is built,
-/// would exceed [`RenderOptions::max_quads`].
-fn check_forced_level(base: &BaseMesh, forced: usize, opts: &RenderOptions) -> Result<(), Error> {
-    let k = forced_level(base, forced);
-    let estimate = crate::limits::estimate_refinement(base, k);
-    let quads = estimate.levels.get(k).map_or(u64::MAX, |c| c.faces);
-    if quads > opts.max_quads as u64 {
-        return Err(ErrorKind::LimitExceeded {
-            what: format!("the number of quads of refinement level {k}, the level asked for"),
-            found: quads,
-            limit: opts.max_quads as u64,
-        }
-        .into());
-    }
-    Ok(())
-}
-
 /// The limit data of level `k >= 2` (all quads), without copying the level's data.
 fn limit_of(refinement: &mut Refinement, data: &RefinedMesh, k: usize) -> Vec<VertexData> {
     match limit::limit_stencils(refinement.level(k)) {
@@ -498,16 +481,15 @@ pub(crate) fn prepare(
     // levels it needs (level 2 of a dense mesh is costly and often not needed). An edited layer
     // whose topology stayed takes the levels its last preparation built.
     let (base, warnings) = BaseMesh::new(&mesh).map_err(|e| e.in_layer(index))?;
-    if let Some(forced) = opts.level {
-        check_forced_level(&base, forced, opts).map_err(|e| e.in_layer(index))?;
-    }
-    // Interpolated positions build the levels down to where no semi-sharp feature is left,
-    // whatever the image needs: those count against the quads of any level built too.
+    // Every level built counts against `max_quads`, estimated before anything is built: a
+    // forced level, and the levels interpolated positions need down to where no semi-sharp
+    // feature is left, whatever the image needs.
+    let deepest = opts.level.map_or(1, |forced| forced_level(&base, forced));
     Limits {
         refined_faces: opts.max_quads as u64,
         ..Limits::NONE
     }
-    .check_refinement(&base, 1)
+    .check_refinement(&base, deepest)
     .map_err(|e| e.in_layer(index))?;
     let kept = memo.as_deref_mut().and_then(|m| m.refinement.take());
     let mut refinement = Refinement::rebased_or_new(kept, base, 1);
