@@ -447,7 +447,7 @@ fn edits_are_listed_and_applied_by_refine() {
 /// top: every way gives the bytes the library's image path encodes.
 #[test]
 fn render_writes_the_image_paths_pixels() {
-    use gradmesh::render::{encode_png, render_image, RenderOptions, View};
+    use gradmesh::render::{encode_png, render_image, PngDepth, RenderOptions, View};
     let dir = tempfile::tempdir().unwrap();
     let input = realdata().join("Glasses.off");
     let doc = gradmesh::formats::read_path(&input).unwrap();
@@ -455,17 +455,17 @@ fn render_writes_the_image_paths_pixels() {
     let view = View::fit(&doc, 0.0);
     let height = (240.0 * view.height() / view.width()).round() as u32;
     let (image, _) = render_image(&doc, &RenderOptions::new(240, height, view)).unwrap();
-    for (extra, bits, dither) in [
-        (&[][..], 8, true),
-        (&["--bits", "16"][..], 16, true),
-        (&["--no-dither"][..], 8, false),
+    for (extra, depth) in [
+        (&[][..], PngDepth::Eight { dither: true }),
+        (&["--bits", "16"][..], PngDepth::Sixteen),
+        (&["--no-dither"][..], PngDepth::Eight { dither: false }),
     ] {
         let out = dir.path().join("out.png");
         let mut args = vec!["render", s(&input), "-o", s(&out), "--width", "240"];
         args.extend_from_slice(extra);
         let o = gradmesh(&args);
         assert!(o.status.success(), "{}", stderr(&o));
-        let expect = encode_png(&image, bits, dither).unwrap();
+        let expect = encode_png(&image, depth).unwrap();
         assert!(std::fs::read(&out).unwrap() == expect, "{extra:?}");
     }
     // `--linear-colour` is the library's `quadratic: false`, and draws other pixels.
@@ -484,9 +484,9 @@ fn render_writes_the_image_paths_pixels() {
     ];
     let o = gradmesh(&args);
     assert!(o.status.success(), "{}", stderr(&o));
-    let expect = encode_png(&linear, 8, true).unwrap();
+    let expect = encode_png(&linear, PngDepth::Eight { dither: true }).unwrap();
     assert!(std::fs::read(&out).unwrap() == expect);
-    assert!(expect != encode_png(&image, 8, true).unwrap());
+    assert!(expect != encode_png(&image, PngDepth::Eight { dither: true }).unwrap());
 }
 
 /// An absurd request: the command fails with exit status 1 (as every refused limit does) and

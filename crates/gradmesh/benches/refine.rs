@@ -7,11 +7,11 @@
 #![allow(missing_docs)] // criterion_group! generates undocumented items.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use gradmesh::catmull_clark;
-use gradmesh::limit::limit_stencils;
-use gradmesh::refine::Refinement;
-use gradmesh::ternary_step::{ternary_data, ternary_level};
-use gradmesh::validate::BaseMesh;
+use gradmesh::internals::catmull_clark;
+use gradmesh::internals::limit::limit_stencils;
+use gradmesh::internals::ternary_step::{ternary_data, ternary_level};
+use gradmesh::BaseMesh;
+use gradmesh::Refinement;
 
 mod common;
 use common::mesh;

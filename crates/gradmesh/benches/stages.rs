@@ -10,11 +10,11 @@
 mod common;
 
 use criterion::{black_box, criterion_group, criterion_main, BatchSize, Criterion};
-use gradmesh::catmull_clark;
-use gradmesh::limit::limit_stencils;
+use gradmesh::internals::catmull_clark;
+use gradmesh::internals::limit::limit_stencils;
+use gradmesh::internals::ternary_step::{ternary_data, ternary_level};
 use gradmesh::render::GamutMapping;
-use gradmesh::ternary_step::{ternary_data, ternary_level};
-use gradmesh::validate::BaseMesh;
+use gradmesh::BaseMesh;
 use gradmesh::ColourSpace;
 
 fn bench(c: &mut Criterion) {

@@ -8,9 +8,9 @@
 
 use std::path::Path;
 
-use gradmesh::colour::ColourSpace;
 use gradmesh::formats::read_path;
-use gradmesh::render::{encode_png, render_document, Image, RenderOptions};
+use gradmesh::render::{encode_png, render_document, Image, PngDepth, RenderOptions};
+use gradmesh::ColourSpace;
 use gradmesh::{Document, FirstStep};
 use palette::color_difference::Ciede2000;
 use palette::{white_point::D65, Lab};
@@ -93,7 +93,7 @@ fn main() -> Result<(), gradmesh::Error> {
         let mut images = Vec::new();
         for (variant, d) in variants(&doc) {
             let image = render_document(&d, &opts)?;
-            let png = encode_png(&image, 8, true)?;
+            let png = encode_png(&image, PngDepth::Eight { dither: true })?;
             std::fs::write(out.join(format!("{name}-{variant}.png")), png)
                 .map_err(|e| gradmesh::Error::new(gradmesh::ErrorKind::Io(e.to_string())))?;
             images.push(image);

@@ -169,6 +169,9 @@ pub enum ErrorKind {
         /// The limit.
         limit: u64,
     },
+    /// A file's extension names no format that the operation reads or writes.
+    #[error("{0}")]
+    UnsupportedFormat(String),
     /// Reading or writing a file failed.
     #[error("{0}")]
     Io(String),

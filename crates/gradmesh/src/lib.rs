@@ -4,16 +4,17 @@
 //! Topologically Unrestricted Gradient Meshes" (Computer Graphics Forum 36(6), 2017):
 //!
 //! 1. [`GradientMesh`]: control points with colours, handles and edge tags, checked by
-//!    [`validate`](fn@validate);
-//! 2. [`ternary_step`](mod@ternary_step): the special first refinement that makes colours interpolating
-//!    (or [`binary_step`](mod@binary_step), the paper's alternative of two binary splits);
-//! 3. [`catmull_clark`](mod@catmull_clark): Catmull-Clark refinement with Pixar's rules, topology refined once and
-//!    data interpolated with precomputed stencils;
-//! 4. [`edits`](mod@edits): multi-resolution edits, applied to refined levels between steps;
-//! 5. [`limit`](mod@limit): limit positions and colours of refined vertices.
+//!    [`validate`](fn@validate) into a [`BaseMesh`] (discontinuities split);
+//! 2. the ternary step: the special first refinement that makes colours interpolating (or
+//!    the paper's alternative of two binary splits, [`FirstStep`]);
+//! 3. Catmull-Clark refinement with Pixar's rules, topology refined once and data
+//!    interpolated with precomputed stencils ([`Refinement`], [`refine_level`]);
+//! 4. multi-resolution edits ([`Edit`]), applied to refined levels between steps;
+//! 5. limit positions and colours of refined vertices ([`Refinement::limit`]);
+//! 6. [`formats`] reads and writes files, and [`render`] draws the limit surface.
 //!
 //! ```
-//! use gradmesh::{refine::Refinement, ColourSpace, GradientMesh};
+//! use gradmesh::{ColourSpace, GradientMesh, Refinement};
 //! use kurbo::Point;
 //!
 //! let mut mesh = GradientMesh::new(ColourSpace::Lab);
@@ -32,34 +33,68 @@
 //! # Ok::<(), gradmesh::Error>(())
 //! ```
 
-pub mod binary_step;
-pub mod catmull_clark;
-pub mod colour;
-pub mod edit_check;
-pub mod edits;
-pub mod error;
+mod binary_step;
+mod catmull_clark;
+mod colour;
+mod edit_check;
+mod edits;
+mod error;
 pub mod formats;
-pub mod level;
-pub mod limit;
-pub mod limits;
-pub mod mesh;
-pub mod multires;
-pub mod refine;
+mod level;
+mod limit;
+mod limits;
+mod mesh;
+mod multires;
+mod refine;
 pub mod render;
-pub mod rules;
-pub mod scheme;
-pub mod ternary_step;
-pub mod topology;
-pub mod validate;
+mod rules;
+mod scheme;
+mod ternary_step;
+mod topology;
+mod validate;
 
-pub use colour::ColourSpace;
+pub use colour::{parse_css_colour, ColourSpace};
+pub use edit_check::EditSet;
 pub use error::{Error, ErrorKind, Location, Result, Warning};
 pub use limits::Limits;
-pub use mesh::{
-    BoundaryInterpolation, ControlPoint, CreasingMethod, Document, EdgeKind, EdgeTag, FirstStep,
-    GradientMesh, WedgeOverride,
-};
-pub use multires::{ColourEdit, Edit, FineEdits, OpacityEdit, VertexAddress};
-pub use refine::{RefinedMesh, Refinement};
+pub use mesh::{ControlPoint, Document, EdgeKind, EdgeTag, GradientMesh, WedgeOverride};
+pub use multires::{ColourEdit, Edit, FineEdits, OpacityEdit, VertexAddress, MAX_EDIT_LEVEL};
+pub use refine::{refine_level, LevelPoints, RefinedData, RefinedLevel, Refinement};
+pub use scheme::{BoundaryInterpolation, CreasingMethod, FirstStep, SHARPNESS_INFINITE};
 pub use topology::Topology;
-pub use validate::validate;
+pub use validate::{validate, BaseMesh, VertexData};
+
+/// The README's Rust examples, compiled and run by `cargo test --doc`.
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+struct ReadmeExamples;
+
+/// The pipeline's inner steps, for tests against independent oracles and for benchmarks. Not a
+/// stable API: these change with the implementation.
+#[doc(hidden)]
+pub mod internals {
+    /// The paper's alternative first step: two binary splits.
+    pub mod binary_step {
+        pub use crate::binary_step::*;
+    }
+    /// One Catmull-Clark step and its stencils.
+    pub mod catmull_clark {
+        pub use crate::catmull_clark::*;
+    }
+    /// Limit stencils.
+    pub mod limit {
+        pub use crate::limit::*;
+    }
+    /// Refinement size estimates.
+    pub mod limits {
+        pub use crate::limits::*;
+    }
+    /// Pixar's subdivision rules.
+    pub mod rules {
+        pub use crate::rules::*;
+    }
+    /// The paper's ternary first step.
+    pub mod ternary_step {
+        pub use crate::ternary_step::*;
+    }
+}

@@ -7,7 +7,7 @@
 //! trusts its input raises a field:
 //!
 //! ```
-//! use gradmesh::limits::Limits;
+//! use gradmesh::Limits;
 //!
 //! let limits = Limits {
 //!     refined_faces: 1 << 26,

@@ -9,8 +9,8 @@ use kurbo::Vec2;
 /// The deepest level an edit may name (a sector then has 3 * 2^6 = 192 quads a side).
 pub const MAX_EDIT_LEVEL: u32 = 8;
 
-/// The name of a vertex of a refined level, through the coarse face and corner it lies in (see
-/// the [module documentation](self)).
+/// The name of a vertex of a refined level, through the coarse face and corner it lies in
+/// (`docs/format.md`, section 1.5, describes the addressing and what an edit does).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct VertexAddress {
     /// The level, 1 (after the ternary step) or deeper.

@@ -44,7 +44,7 @@ static NEXT_TOPOLOGY_ID: AtomicU64 = AtomicU64::new(0);
 
 /// The data (positions, colours, opacity) of every level of a [`Refinement`].
 #[derive(Clone, Debug, PartialEq)]
-pub struct RefinedMesh {
+pub struct RefinedData {
     /// `levels[k]` holds the data of level `k`.
     pub levels: Vec<Vec<VertexData>>,
 }
@@ -182,6 +182,15 @@ impl Refinement {
         }
     }
 
+    /// The topology of level `k`, taking the refinement apart.
+    fn into_topology(mut self, k: usize) -> Topology {
+        if k == 0 {
+            self.base.topology
+        } else {
+            self.levels.swap_remove(k - 1).topology
+        }
+    }
+
     /// The index at level `k` of the vertex that base vertex `v` becomes (its vertex point at
     /// every level). Levels beyond [`Refinement::depth`] are not built: `k` must not exceed it.
     pub fn vertex_at_level(&self, v: u32, k: usize) -> usize {
@@ -199,8 +208,8 @@ impl Refinement {
     }
 
     /// Evaluates the data of every level from the base data.
-    pub fn evaluate(&self) -> RefinedMesh {
-        self.evaluate_with(&self.base)
+    pub fn evaluate(&self) -> RefinedData {
+        self.evaluate_from(&self.base)
     }
 
     /// Evaluates every level from other base data on the same topology (for example after an
@@ -208,22 +217,22 @@ impl Refinement {
     ///
     /// # Panics
     /// If `base` has another topology than the one refined.
-    pub fn evaluate_with(&self, base: &BaseMesh) -> RefinedMesh {
+    pub fn evaluate_from(&self, base: &BaseMesh) -> RefinedData {
         self.evaluate_to(base, self.levels.len())
     }
 
-    /// [`Refinement::evaluate_with`] down to level `depth` only (or the deepest built).
-    pub fn evaluate_to(&self, base: &BaseMesh, depth: usize) -> RefinedMesh {
+    /// [`Refinement::evaluate_from`] down to level `depth` only (or the deepest built).
+    pub fn evaluate_to(&self, base: &BaseMesh, depth: usize) -> RefinedData {
         let depth = depth.min(self.levels.len());
         let mut levels = vec![base.data.clone()];
         if depth >= 1 {
             levels.push(self.first_level_data(base));
         }
         for k in 1..depth {
-            let next = self.next_level_data_with(base, k, &levels[k]);
+            let next = self.next_level_data_from(base, k, &levels[k]);
             levels.push(next);
         }
-        RefinedMesh { levels }
+        RefinedData { levels }
     }
 
     /// The level-1 data of `base`: the first step, the position correction when positions are
@@ -242,11 +251,11 @@ impl Refinement {
     /// Renderers and writers that go one level further should use this, not the bare stencils,
     /// so that edits apply.
     pub fn next_level_data(&self, k: usize, data: &[VertexData]) -> Vec<VertexData> {
-        self.next_level_data_with(&self.base, k, data)
+        self.next_level_data_from(&self.base, k, data)
     }
 
     /// As [`Refinement::next_level_data`], with the edits of other base data.
-    pub fn next_level_data_with(
+    pub fn next_level_data_from(
         &self,
         base: &BaseMesh,
         k: usize,
@@ -310,7 +319,7 @@ impl Refinement {
     /// The limit position, colour and opacity of every vertex of level `k`, refining one or two
     /// levels further where level `k` still has faces that are not quads, and below the
     /// deepest edit.
-    pub fn limit(&mut self, data: &RefinedMesh, k: usize) -> Vec<VertexData> {
+    pub fn limit(&mut self, data: &RefinedData, k: usize) -> Vec<VertexData> {
         // Vertex v of level j has the vertex point nf + ne + v at level j + 1 (j >= 1), and
         // vertex point v at level 1 (j = 0); both have the same limit.
         let mut j = k;
@@ -382,7 +391,7 @@ impl Refinement {
     }
 
     /// The data at level `j`, computing levels beyond those in `data` when needed.
-    fn level_data(&self, data: &RefinedMesh, j: usize) -> Vec<VertexData> {
+    fn level_data(&self, data: &RefinedData, j: usize) -> Vec<VertexData> {
         if let Some(d) = data.levels.get(j) {
             return d.clone();
         }
@@ -420,6 +429,104 @@ fn first_data(base: &BaseMesh) -> Vec<VertexData> {
 fn has_semi_sharp(level: &Level) -> bool {
     let semi = |&s: &f64| rules::is_sharp(s) && !rules::is_infinite(s);
     level.edge_sharpness.iter().any(semi) || level.vertex_sharpness.iter().any(semi)
+}
+
+/// One level of a mesh's refinement: its topology and the data of its vertices.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RefinedLevel {
+    /// The level's faces, edges and vertex rings.
+    pub topology: Topology,
+    /// Position, colour (in the mesh's colour space) and opacity of each vertex.
+    pub data: Vec<VertexData>,
+}
+
+/// Which points of a level [`refine_level`] gives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LevelPoints {
+    /// The refined control points.
+    Control,
+    /// The points of the limit surface that the level's vertices converge to.
+    Limit,
+}
+
+/// Level `level` of `mesh`, its control points or their limits, within `limits`; warnings
+/// include edits that lie below a level of control points and have no effect on it.
+///
+/// Without edits or interpolated positions, a level of control points is computed holding at
+/// most two levels at a time and never the last step's stencils: the memory of the output
+/// and of its parent level, not of the whole refinement.
+pub fn refine_level(
+    mesh: &GradientMesh,
+    level: usize,
+    points: LevelPoints,
+    limits: &Limits,
+) -> Result<(RefinedLevel, Vec<Warning>), Error> {
+    let streamed = points == LevelPoints::Control
+        && level >= 1
+        && !mesh.interpolate_positions
+        && mesh.edits.is_empty();
+    if streamed {
+        return refine_level_streamed(mesh, level, limits);
+    }
+    let (mut refinement, mut warnings) = Refinement::new_with_limits(mesh, level, limits)?;
+    let deepest_edit = refinement.base().edits.deepest_level();
+    match points {
+        // Limit points of levels 0 and 1 are computed from level 2.
+        LevelPoints::Limit => {
+            limits.check_refinement(refinement.base(), level.max(2))?;
+        }
+        LevelPoints::Control if deepest_edit > level => warnings.push(Warning {
+            layer: None,
+            message: format!(
+                "edits down to level {deepest_edit} lie below the level written ({level}) and \
+                 have no effect on it"
+            ),
+        }),
+        LevelPoints::Control => {}
+    }
+    let mut all = refinement.evaluate();
+    let data = match points {
+        LevelPoints::Limit => refinement.limit(&all, level),
+        LevelPoints::Control => std::mem::take(&mut all.levels[level]),
+    };
+    drop(all);
+    let topology = refinement.into_topology(level);
+    Ok((RefinedLevel { topology, data }, warnings))
+}
+
+/// [`refine_level`] of control points at `level >= 1` for a mesh without edits or
+/// interpolated positions, one step at a time.
+fn refine_level_streamed(
+    mesh: &GradientMesh,
+    level: usize,
+    limits: &Limits,
+) -> Result<(RefinedLevel, Vec<Warning>), Error> {
+    limits.check_mesh(mesh)?;
+    let (base, warnings) = BaseMesh::new(mesh)?;
+    limits.check_refinement(&base, level)?;
+    let (mut parent, mut data) = match base.first_step {
+        FirstStep::Ternary => (
+            ternary_step::ternary_level(&base),
+            ternary_step::ternary_data(&base),
+        ),
+        FirstStep::Binary => (
+            binary_step::binary_level(&base),
+            binary_step::binary_data(&base),
+        ),
+    };
+    drop(base);
+    for _ in 2..level {
+        let (child, stencils) = catmull_clark::refine(&parent);
+        data = stencils.apply(&data);
+        parent = child;
+    }
+    let topology = if level >= 2 {
+        data = catmull_clark::refine_data(&parent, &data);
+        parent.topology.subdivide()
+    } else {
+        parent.topology
+    };
+    Ok((RefinedLevel { topology, data }, warnings))
 }
 
 #[cfg(test)]

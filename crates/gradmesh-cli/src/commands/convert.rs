@@ -7,7 +7,7 @@ use crate::args::ConvertArgs;
 
 pub fn run(args: &ConvertArgs) -> Result<(), Error> {
     if Format::from_path(&args.output) != Some(Format::Json) {
-        return Err(Error::new(ErrorKind::Io(format!(
+        return Err(Error::new(ErrorKind::UnsupportedFormat(format!(
             "{}: convert writes the native format; give the output a .json extension",
             args.output.display()
         ))));

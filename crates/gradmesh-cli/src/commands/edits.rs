@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use gradmesh::refine::Refinement;
+use gradmesh::Refinement;
 use gradmesh::{ColourEdit, Edit, Error, OpacityEdit};
 
 use crate::args::EditsArgs;

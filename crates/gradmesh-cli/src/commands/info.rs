@@ -3,8 +3,8 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
-use gradmesh::topology::Topology;
-use gradmesh::validate::BaseMesh;
+use gradmesh::BaseMesh;
+use gradmesh::Topology;
 use gradmesh::{EdgeKind, Error, GradientMesh};
 
 use super::Failure;

@@ -39,7 +39,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
 
 /// Reads a document within `limits`, with errors located in the file.
 fn read(path: &Path, limits: &gradmesh::Limits) -> Result<Document, Error> {
-    gradmesh::formats::read_path_with(path, limits)
+    gradmesh::formats::read_path_with_limits(path, limits)
 }
 
 /// Refuses to write over an input unless `force` is given.

@@ -2,9 +2,9 @@
 
 use std::time::Instant;
 
-use gradmesh::colour::parse_css_colour;
 use gradmesh::formats;
-use gradmesh::render::{self, RenderOptions, View};
+use gradmesh::parse_css_colour;
+use gradmesh::render::{self, PngDepth, RenderOptions, View};
 use gradmesh::{ColourSpace, Document, Error, ErrorKind};
 
 use crate::args::RenderArgs;
@@ -124,9 +124,17 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     // synced to disk and then replaces the output.
     let start = Instant::now();
     let (w, h) = (opts.width, opts.height);
-    formats::write_atomic_with(&args.output, |out| {
+    formats::write_atomic_streamed(&args.output, |out| {
         match &pixels {
-            Pixels::Float(image) => render::write_png(out, image, args.bits, opts.dither),
+            Pixels::Float(image) => {
+                let depth = match args.bits {
+                    16 => PngDepth::Sixteen,
+                    _ => PngDepth::Eight {
+                        dither: opts.dither,
+                    },
+                };
+                render::write_png(out, image, depth)
+            }
             Pixels::Sixteen(data) => render::write_png_rgba16(out, w, h, data),
             Pixels::Eight(data) => render::write_png_rgba8(out, w, h, data),
         }

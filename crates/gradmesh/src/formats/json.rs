@@ -51,13 +51,13 @@ pub const MAX_NESTING_DEPTH: usize = Limits::DEFAULT.nesting_depth;
 ///
 /// Input beyond the default [`Limits`] is refused.
 pub fn read_document(text: &str) -> Result<Document, Error> {
-    read_document_with(text, &Limits::DEFAULT)
+    read_document_with_limits(text, &Limits::DEFAULT)
 }
 
 /// Reads a document in the native format as [`read_document`] does, within `limits`: input
 /// bytes and nesting depth (checked before parsing), and points, faces and corners of each
 /// layer (checked before the layer is converted).
-pub fn read_document_with(text: &str, limits: &Limits) -> Result<Document, Error> {
+pub fn read_document_with_limits(text: &str, limits: &Limits) -> Result<Document, Error> {
     check_size(text.len() as u64, limits.input_bytes)?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     check_nesting(text, limits.nesting_depth)?;

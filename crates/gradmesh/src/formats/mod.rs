@@ -1,7 +1,7 @@
 //! Reading and writing gradient meshes: the native JSON format, the authors' OFF, and OBJ.
 //!
 //! The native format is specified in `docs/format.md`. Every reader reports errors with the line
-//! they occur on, and refuses input beyond its [`Limits`] (the `_with` functions; the others use
+//! they occur on, and refuses input beyond its [`Limits`] (the `_with_limits` functions; the others use
 //! [`Limits::DEFAULT`]) before allocating for it.
 
 pub mod json;
@@ -66,14 +66,18 @@ impl Format {
 /// Reads a document from text in the given format, within the default [`Limits`]. OFF and OBJ
 /// files give one unnamed layer.
 pub fn read_str(text: &str, format: Format) -> Result<Document, Error> {
-    read_str_with(text, format, &Limits::DEFAULT)
+    read_str_with_limits(text, format, &Limits::DEFAULT)
 }
 
 /// Reads a document from text in the given format, refusing input beyond `limits` (input bytes,
 /// points, faces and corners per mesh, JSON nesting). OFF and OBJ files give one unnamed layer.
-pub fn read_str_with(text: &str, format: Format, limits: &Limits) -> Result<Document, Error> {
+pub fn read_str_with_limits(
+    text: &str,
+    format: Format,
+    limits: &Limits,
+) -> Result<Document, Error> {
     match format {
-        Format::Json => json::read_document_with(text, limits),
+        Format::Json => json::read_document_with_limits(text, limits),
         Format::Off => off::read_off_with(text, limits).map(single_layer),
         Format::Obj => obj::read_obj_with(text, limits).map(single_layer),
     }
@@ -83,12 +87,12 @@ pub fn read_str_with(text: &str, format: Format, limits: &Limits) -> Result<Docu
 /// extension. OFF and OBJ files give one layer named after the file stem. Every error is located
 /// in the file.
 pub fn read_path(path: &Path) -> Result<Document, Error> {
-    read_path_with(path, &Limits::DEFAULT)
+    read_path_with_limits(path, &Limits::DEFAULT)
 }
 
 /// Reads a document from a file as [`read_path`] does, refusing input beyond `limits`. A file
 /// larger than [`Limits::input_bytes`] is refused before it is read.
-pub fn read_path_with(path: &Path, limits: &Limits) -> Result<Document, Error> {
+pub fn read_path_with_limits(path: &Path, limits: &Limits) -> Result<Document, Error> {
     read_path_unlocated(path, limits).map_err(|e| e.in_file(path))
 }
 
@@ -98,12 +102,12 @@ fn read_path_unlocated(path: &Path, limits: &Limits) -> Result<Document, Error> 
             Some(ext) => format!("the extension \".{}\"", ext.to_string_lossy()),
             None => "no extension".to_string(),
         };
-        Error::new(ErrorKind::Io(format!(
+        Error::new(ErrorKind::UnsupportedFormat(format!(
             "cannot tell the format from {found}: expected .json, .off or .obj"
         )))
     })?;
     let text = read_text(path, limits.input_bytes)?;
-    let mut doc = read_str_with(&text, format, limits)?;
+    let mut doc = read_str_with_limits(&text, format, limits)?;
     if format != Format::Json {
         if let Some(stem) = path.file_stem() {
             for layer in &mut doc.layers {
@@ -196,12 +200,12 @@ static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 ///
 /// An existing file's permissions are kept. The error is located in `path`.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
-    write_atomic_with(path, |w| w.write_all(bytes))
+    write_atomic_streamed(path, |w| w.write_all(bytes))
 }
 
 /// As [`write_atomic`], for output produced piece by piece: `write` streams into the
 /// temporary file (buffered), so a large output is never held in memory whole.
-pub fn write_atomic_with(
+pub fn write_atomic_streamed(
     path: &Path,
     write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<(), Error> {

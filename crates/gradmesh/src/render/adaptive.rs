@@ -28,7 +28,7 @@ use rayon::prelude::*;
 
 use crate::colour::{ColourSpace, Matrix3};
 use crate::level::Level;
-use crate::refine::{RefinedMesh, Refinement};
+use crate::refine::{RefinedData, Refinement};
 use crate::rules;
 use crate::topology::Topology;
 use crate::validate::VertexData;
@@ -524,7 +524,7 @@ pub(crate) struct Kept<'a> {
 /// [`DEEPEST_BASE_LEVEL`]): the caller then refines uniformly.
 pub(super) fn tessellate(
     refinement: &mut Refinement,
-    data: &mut RefinedMesh,
+    data: &mut RefinedData,
     xf: &ToPixels,
     th: &Thresholds,
     max_level: usize,
@@ -1501,7 +1501,7 @@ mod tests {
     /// [`tessellate`] down to level 12, with local refinements of its own.
     fn tessellate_alone(
         refinement: &mut Refinement,
-        data: &mut RefinedMesh,
+        data: &mut RefinedData,
         xf: &ToPixels,
         th: &Thresholds,
         size: (i64, i64),

@@ -10,7 +10,7 @@ use kurbo::{Point, Rect};
 
 use crate::error::Error;
 use crate::mesh::GradientMesh;
-use crate::refine::{RefinedMesh, Refinement};
+use crate::refine::{RefinedData, Refinement};
 use crate::ternary_step::first_child_face;
 use crate::topology::{Topology, INVALID};
 
@@ -79,7 +79,7 @@ fn base_face(refinement: &Refinement, k: usize, f: usize) -> usize {
 /// The folds of the limit surface seen at level `level` (at least 2) of a refinement whose data
 /// is `data`: quads (split along their first diagonal) whose limit corners turn against the
 /// orientation of most of the surface, grouped into regions joined by edges.
-pub fn find_folds_at(refinement: &mut Refinement, data: &RefinedMesh, level: usize) -> Vec<Fold> {
+pub fn find_folds_at(refinement: &mut Refinement, data: &RefinedData, level: usize) -> Vec<Fold> {
     let k = level.max(2);
     refinement.extend_to(k);
     let lim = refinement.limit(data, k);

@@ -10,7 +10,7 @@ use crate::error::{Error, Warning};
 use crate::limit;
 use crate::limits::Limits;
 use crate::mesh::GradientMesh;
-use crate::refine::{RefinedMesh, Refinement};
+use crate::refine::{RefinedData, Refinement};
 use crate::topology::Topology;
 use crate::validate::BaseMesh;
 use crate::validate::VertexData;
@@ -271,7 +271,7 @@ fn forced_level(base: &BaseMesh, forced: usize) -> usize {
 }
 
 /// The limit data of level `k >= 2` (all quads), without copying the level's data.
-fn limit_of(refinement: &mut Refinement, data: &RefinedMesh, k: usize) -> Vec<VertexData> {
+fn limit_of(refinement: &mut Refinement, data: &RefinedData, k: usize) -> Vec<VertexData> {
     match limit::limit_stencils(refinement.level(k)) {
         Some(st) => st.apply(&data.levels[k]),
         None => refinement.limit(data, k),
@@ -290,7 +290,7 @@ fn limit_of(refinement: &mut Refinement, data: &RefinedMesh, k: usize) -> Vec<Ve
 /// beyond the drawn one is built. Returns the choice and the limit data of the chosen level.
 fn choose_level(
     refinement: &mut Refinement,
-    data: &mut RefinedMesh,
+    data: &mut RefinedData,
     xf: &ToPixels,
     opts: &RenderOptions,
     space: ColourSpace,
@@ -311,7 +311,7 @@ fn choose_level(
         )
     };
     let size = (opts.width as f64, opts.height as f64);
-    let extend = |refinement: &mut Refinement, data: &mut RefinedMesh, k: usize| {
+    let extend = |refinement: &mut Refinement, data: &mut RefinedData, k: usize| {
         while data.levels.len() <= k {
             let j = data.levels.len() - 1;
             refinement.extend_to(j + 1);

@@ -71,7 +71,7 @@
 //! renders, so an editor pays only for the layers an edit changed.
 //!
 //! ```
-//! use gradmesh::render::{render_document, RenderOptions, View};
+//! use gradmesh::render::{render_document, PngDepth, RenderOptions, View};
 //! use gradmesh::{ColourSpace, Document, GradientMesh};
 //! use kurbo::Point;
 //!
@@ -85,7 +85,7 @@
 //! let opts = RenderOptions::fit(&doc, 64);
 //! let image = render_document(&doc, &opts)?;
 //! assert_eq!(image.width, 64);
-//! let png = gradmesh::render::encode_png(&image, 8, true)?;
+//! let png = gradmesh::render::encode_png(&image, PngDepth::Eight { dither: true })?;
 //! assert_eq!(&png[1..4], b"PNG");
 //! # Ok::<(), gradmesh::Error>(())
 //! ```
@@ -131,7 +131,7 @@ pub use options::{
 };
 pub use output::{
     encode_png, encode_png_rgba16, encode_png_rgba8, write_png, write_png_rgba16, write_png_rgba8,
-    Image, OutputPixel,
+    Image, OutputPixel, PngDepth,
 };
 pub use overlay::draw_outlines;
 pub use view::{document_bounds, View};

@@ -11,11 +11,9 @@ use crate::colour::ColourSpace;
 pub const MAX_SIDE: u32 = 1 << 15;
 /// The default largest pixel count ([`RenderOptions::max_pixels`]): 100 megapixels.
 pub const MAX_PIXELS: u64 = 100_000_000;
-/// The largest magnitude of a view's coordinates: that of a mesh's
-/// ([`crate::validate::MAX_MAGNITUDE`]).
+/// The largest magnitude of a view's coordinates (1e150): that of a mesh's.
 pub const MAX_VIEW_MAGNITUDE: f64 = crate::validate::MAX_MAGNITUDE;
-/// The smallest pixel, in plane units: a mesh's shortest edge
-/// ([`crate::validate::MIN_EDGE_LENGTH`]).
+/// The smallest pixel, in plane units (1e-150): a mesh's shortest edge.
 pub const MIN_PIXEL_SIZE: f64 = crate::validate::MIN_EDGE_LENGTH;
 /// The smallest pixel relative to the view's largest coordinate (2^-32): smaller pixels leave
 /// too few bits of a coordinate to place anti-aliased edges within them.

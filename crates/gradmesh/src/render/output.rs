@@ -223,13 +223,25 @@ impl Image {
     }
 }
 
-/// Encodes an image as an RGBA PNG of 8 or 16 bits per channel, marked as sRGB (an `sRGB` chunk,
-/// perceptual intent, with the fallback `gAMA` and `cHRM` the PNG specification recommends).
-/// `dither` applies to 8-bit output only. [`write_png`] writes it to a file (or any writer)
-/// as it is encoded instead.
-pub fn encode_png(image: &Image, bits: u8, dither: bool) -> Result<Vec<u8>, Error> {
+/// The channel depth of a PNG made from an [`Image`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PngDepth {
+    /// 8 bits per channel; `dither` adds blue-noise dither before rounding, so that slow
+    /// gradients show no bands.
+    Eight {
+        /// Whether to dither.
+        dither: bool,
+    },
+    /// 16 bits per channel.
+    Sixteen,
+}
+
+/// Encodes an image as an RGBA PNG, marked as sRGB (an `sRGB` chunk, perceptual intent, with
+/// the fallback `gAMA` and `cHRM` the PNG specification recommends). [`write_png`] writes it
+/// to a file (or any writer) as it is encoded instead.
+pub fn encode_png(image: &Image, depth: PngDepth) -> Result<Vec<u8>, Error> {
     let mut out = Vec::new();
-    write_png(&mut out, image, bits, dither)?;
+    write_png(&mut out, image, depth)?;
     Ok(out)
 }
 
@@ -252,15 +264,12 @@ pub fn encode_png_rgba16(width: u32, height: u32, data: &[u16]) -> Result<Vec<u8
 /// [`encode_png`], written to `out` as it is encoded, so that the caller holds no copy of the
 /// file (for 8 bits `png` keeps the compressed stream until the end; 16-bit rows are
 /// converted and compressed a band at a time). The bytes are those [`encode_png`] returns.
-pub fn write_png(out: impl Write, image: &Image, bits: u8, dither: bool) -> Result<(), Error> {
-    match bits {
-        8 => write_png_rgba8(out, image.width, image.height, &image.to_u8(dither)),
-        16 => write_png_rgba16(out, image.width, image.height, &image.to_u16()),
-        _ => Err(ErrorKind::Invalid {
-            what: "PNG bit depth".into(),
-            message: format!("must be 8 or 16, not {bits}"),
+pub fn write_png(out: impl Write, image: &Image, depth: PngDepth) -> Result<(), Error> {
+    match depth {
+        PngDepth::Eight { dither } => {
+            write_png_rgba8(out, image.width, image.height, &image.to_u8(dither))
         }
-        .into()),
+        PngDepth::Sixteen => write_png_rgba16(out, image.width, image.height, &image.to_u16()),
     }
 }
 
@@ -499,22 +508,21 @@ mod tests {
         for (i, v) in img.data.iter_mut().enumerate() {
             *v = i as f32 / 23.0;
         }
-        for bits in [8, 16] {
-            let bytes = encode_png(&img, bits, false).unwrap();
+        for depth in [PngDepth::Eight { dither: false }, PngDepth::Sixteen] {
+            let bytes = encode_png(&img, depth).unwrap();
             let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
             let mut reader = decoder.read_info().unwrap();
             assert!(reader.info().srgb.is_some());
             let mut buf = vec![0; reader.output_buffer_size().unwrap()];
             let frame = reader.next_frame(&mut buf).unwrap();
             assert_eq!((frame.width, frame.height), (3, 2));
-            if bits == 16 {
+            if depth == PngDepth::Sixteen {
                 let v = u16::from_be_bytes([buf[2 * 5], buf[2 * 5 + 1]]);
                 assert_eq!(v, (5.0 / 23.0 * 65535.0f32 + 0.5) as u16);
             } else {
                 assert_eq!(buf[5], (5.0 / 23.0 * 255.0f32 + 0.5) as u8);
             }
         }
-        assert!(encode_png(&img, 4, false).is_err());
     }
 
     /// 16-bit rows go out in bands of 64: an image of several bands and an odd width comes

@@ -7,9 +7,9 @@
 
 use std::path::{Path, PathBuf};
 
-use gradmesh::colour::ColourSpace;
 use gradmesh::formats::read_path;
 use gradmesh::render::{render_document, Image, RenderOptions};
+use gradmesh::ColourSpace;
 use gradmesh::Document;
 use palette::color_difference::Ciede2000;
 use palette::{white_point::D65, Lab};

@@ -3,12 +3,12 @@
 //! interpolated positions, and how close the result is to the ternary step's.
 
 use crate::common::{build, mesh_spec};
-use gradmesh::binary_step::{edge_midpoint, face_centre, inner_point, HANDLE_SCALE};
 use gradmesh::formats::{json, off::read_off};
-use gradmesh::refine::{RefinedMesh, Refinement};
-use gradmesh::ternary_step::{edge_point, face_point};
-use gradmesh::validate::VertexData;
+use gradmesh::internals::binary_step::{edge_midpoint, face_centre, inner_point, HANDLE_SCALE};
+use gradmesh::internals::ternary_step::{edge_point, face_point};
+use gradmesh::VertexData;
 use gradmesh::{ColourSpace, Document, EdgeKind, FirstStep, GradientMesh};
+use gradmesh::{RefinedData, Refinement};
 use kurbo::{Point, Vec2};
 use proptest::prelude::*;
 
@@ -17,7 +17,7 @@ fn binary(mut mesh: GradientMesh) -> GradientMesh {
     mesh
 }
 
-fn refine(mesh: &GradientMesh, depth: usize) -> (Refinement, RefinedMesh) {
+fn refine(mesh: &GradientMesh, depth: usize) -> (Refinement, RefinedData) {
     let (r, _) = Refinement::new(mesh, depth).expect("a valid mesh");
     let data = r.evaluate();
     (r, data)

@@ -2,10 +2,10 @@
 //! creases are cubic B-spline curves, discontinuous edges separate their sides, and the Euler
 //! characteristic is kept.
 
-use gradmesh::mesh::{WedgeOverride, SHARPNESS_INFINITE};
-use gradmesh::refine::Refinement;
-use gradmesh::topology::Topology;
+use gradmesh::Refinement;
+use gradmesh::Topology;
 use gradmesh::{ColourSpace, EdgeKind, GradientMesh};
+use gradmesh::{WedgeOverride, SHARPNESS_INFINITE};
 use kurbo::{Point, Vec2};
 
 /// A grid of `w` x `h` square cells of side `cell`, with colours from `colour(i, j)`.

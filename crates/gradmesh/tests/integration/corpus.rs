@@ -15,8 +15,8 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use gradmesh::formats;
-use gradmesh::refine::Refinement;
 use gradmesh::render::{document_bounds, render_document, RenderOptions, View};
+use gradmesh::Refinement;
 use gradmesh::{Error, ErrorKind, Limits};
 
 fn corpus_dir() -> PathBuf {

@@ -4,8 +4,8 @@
 //! and to the limit with finite numbers only, and keeps Condition 1: the limit colour and
 //! opacity at each control point's vertex are the point's own.
 
-use gradmesh::refine::Refinement;
 use gradmesh::render::{render_document, RenderOptions, View};
+use gradmesh::Refinement;
 use gradmesh::{validate, ColourSpace, Document, EdgeKind, GradientMesh};
 use kurbo::{Point, Vec2};
 

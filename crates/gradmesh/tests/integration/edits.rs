@@ -4,7 +4,7 @@ use crate::common;
 
 use gradmesh::formats::json::{read_document, write_document};
 use gradmesh::render::{render_document, RenderOptions, View};
-use gradmesh::validate::VertexData;
+use gradmesh::VertexData;
 use gradmesh::{
     ColourEdit, ColourSpace, Document, Edit, FineEdits, FirstStep, GradientMesh, OpacityEdit,
     Refinement, VertexAddress,
@@ -376,7 +376,7 @@ fn fine_edits_follow_coarse_edits() {
     ];
     let (mut r, _) = Refinement::new(&edited, 3).unwrap();
     let data = r.evaluate();
-    let where_ = |r: &mut Refinement, data: &gradmesh::RefinedMesh, i: usize| {
+    let where_ = |r: &mut Refinement, data: &gradmesh::RefinedData, i: usize| {
         let level = edited.edits[i].address.level as usize;
         let v = r.edited_vertex(i).unwrap();
         (v, data.levels[level][v])

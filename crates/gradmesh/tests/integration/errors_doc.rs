@@ -8,8 +8,8 @@ use std::fs;
 use std::path::Path;
 
 use gradmesh::formats::{self, Format};
-use gradmesh::refine::Refinement;
 use gradmesh::render::{render_document, RenderOptions, View};
+use gradmesh::Refinement;
 use gradmesh::{ColourSpace, Document, EdgeKind, Error, GradientMesh, Limits};
 use kurbo::{Point, Vec2};
 
@@ -238,9 +238,12 @@ fn cases() -> Vec<Case> {
         }),
     ];
     // ---- files, refinement, rendering, writing
-    c.push(other("Io", "read_path", "`picture.svg`", || {
-        formats::read_path(Path::new("picture.svg")).map(drop)
-    }));
+    c.push(other(
+        "UnsupportedFormat",
+        "read_path",
+        "`picture.png`",
+        || formats::read_path(Path::new("picture.png")).map(drop),
+    ));
     c.push(other(
         "Io",
         "read_path",
@@ -270,7 +273,7 @@ fn cases() -> Vec<Case> {
     ));
     c.push(other(
         "LimitExceeded",
-        "read_path_with",
+        "read_path_with_limits",
         "`a.obj` of 100 bytes, `Limits { input_bytes: 64, .. }`",
         || {
             let dir = tempfile::tempdir().unwrap();
@@ -280,33 +283,34 @@ fn cases() -> Vec<Case> {
                 input_bytes: 64,
                 ..Limits::DEFAULT
             };
-            formats::read_path_with(&path, &limits)
+            formats::read_path_with_limits(&path, &limits)
                 .map(drop)
                 .map_err(|e| strip(e, dir.path()))
         },
     ));
     c.push(other(
         "LimitExceeded",
-        "read_str_with",
+        "read_str_with_limits",
         "a triangle in OBJ, `Limits { corners: 2, .. }`",
         || {
             let limits = Limits {
                 corners: 2,
                 ..Limits::DEFAULT
             };
-            formats::read_str_with(OBJ_TRI, Format::Obj, &limits).map(drop)
+            formats::read_str_with_limits(OBJ_TRI, Format::Obj, &limits).map(drop)
         },
     ));
     c.push(other(
         "LimitExceeded",
-        "read_str_with",
+        "read_str_with_limits",
         "a triangle in JSON, `Limits { points: 2, .. }`",
         || {
             let limits = Limits {
                 points: 2,
                 ..Limits::DEFAULT
             };
-            formats::read_str_with(&json(TRI, "[0, 1, 2]", ""), Format::Json, &limits).map(drop)
+            formats::read_str_with_limits(&json(TRI, "[0, 1, 2]", ""), Format::Json, &limits)
+                .map(drop)
         },
     ));
     c.push(other(

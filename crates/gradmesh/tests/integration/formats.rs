@@ -384,7 +384,7 @@ fn written_files_read_back() {
 
 #[test]
 fn refined_outputs_are_written() {
-    use gradmesh::refine::Refinement;
+    use gradmesh::Refinement;
     let doc = formats::read_path(&data("triangle.off")).unwrap();
     let mesh = &doc.layers[0];
     let (refinement, _) = Refinement::new(mesh, 2).unwrap();
@@ -441,7 +441,6 @@ fn css_forms_listed_in_the_specification_parse() {
         "oklch(70% 0.1 200)",
         "rebeccapurple",
     ] {
-        gradmesh::colour::parse_css_colour(css, ColourSpace::Lab)
-            .unwrap_or_else(|e| panic!("{css}: {e}"));
+        gradmesh::parse_css_colour(css, ColourSpace::Lab).unwrap_or_else(|e| panic!("{css}: {e}"));
     }
 }

@@ -10,11 +10,11 @@
 //! gradmesh uses the exact mask.
 
 use crate::common::{build, mesh_spec};
-use gradmesh::catmull_clark::{self, Level};
-use gradmesh::limit::limit_stencils;
-use gradmesh::mesh::SHARPNESS_INFINITE;
-use gradmesh::rules::VertexRule;
-use gradmesh::validate::{BaseMesh, VertexData};
+use gradmesh::internals::catmull_clark::{self, Level};
+use gradmesh::internals::limit::limit_stencils;
+use gradmesh::internals::rules::VertexRule;
+use gradmesh::SHARPNESS_INFINITE;
+use gradmesh::{BaseMesh, VertexData};
 use gradmesh::{BoundaryInterpolation, GradientMesh};
 use opensubdiv_rs::far::{
     PrimvarRefiner, TopologyDescriptor, TopologyRefinerFactory, UniformOptions,

@@ -2,7 +2,7 @@
 
 use crate::common::{build, mesh_spec};
 use gradmesh::formats::{json, off::read_off};
-use gradmesh::refine::Refinement;
+use gradmesh::Refinement;
 use gradmesh::{EdgeKind, GradientMesh};
 use proptest::prelude::*;
 

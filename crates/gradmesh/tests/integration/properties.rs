@@ -1,8 +1,8 @@
 //! Property tests of the paper's conditions on random valid meshes of mixed face sizes.
 
 use crate::common::{build, mesh_spec};
-use gradmesh::refine::{RefinedMesh, Refinement};
 use gradmesh::GradientMesh;
+use gradmesh::{RefinedData, Refinement};
 use kurbo::{Affine, Point, Vec2};
 use proptest::prelude::*;
 
@@ -25,7 +25,7 @@ fn colour_bounds(mesh: &GradientMesh) -> ([f64; 4], [f64; 4]) {
     (lo, hi)
 }
 
-fn refine(mesh: &GradientMesh, depth: usize) -> (Refinement, RefinedMesh) {
+fn refine(mesh: &GradientMesh, depth: usize) -> (Refinement, RefinedData) {
     let (r, _) = Refinement::new(mesh, depth).expect("a valid mesh");
     let data = r.evaluate();
     (r, data)

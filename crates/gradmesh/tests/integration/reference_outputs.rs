@@ -6,10 +6,10 @@
 //! matched vertices.
 
 use gradmesh::formats::off::read_off;
-use gradmesh::refine::Refinement;
-use gradmesh::topology::Topology;
-use gradmesh::validate::VertexData;
 use gradmesh::GradientMesh;
+use gradmesh::Refinement;
+use gradmesh::Topology;
+use gradmesh::VertexData;
 
 use crate::realdata;
 

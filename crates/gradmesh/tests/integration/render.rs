@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 
 use gradmesh::render::{
     draw_outlines, encode_png, find_folds, render_document, render_image, BlendSpace, GamutMapping,
-    Image, RenderOptions, View,
+    Image, PngDepth, RenderOptions, View,
 };
 use gradmesh::{ColourSpace, Document, EdgeKind, GradientMesh, Refinement, WedgeOverride};
 use kurbo::{Point, Vec2};
@@ -127,7 +127,11 @@ fn doc(layers: Vec<GradientMesh>) -> Document {
 fn save(name: &str, image: &Image) {
     if let Some(dir) = std::env::var_os("GRADMESH_TEST_PNG_DIR") {
         let path = std::path::Path::new(&dir).join(format!("{name}.png"));
-        std::fs::write(path, encode_png(image, 8, true).unwrap()).unwrap();
+        std::fs::write(
+            path,
+            encode_png(image, PngDepth::Eight { dither: true }).unwrap(),
+        )
+        .unwrap();
     }
 }
 

@@ -3,10 +3,10 @@
 //! Also: the last level's data computed without the stencil table (`refine_data`, used by
 //! `gradmesh refine`) equals applying the table.
 
-use gradmesh::catmull_clark;
 use gradmesh::formats::{self, obj};
-use gradmesh::refine::Refinement;
-use gradmesh::validate::VertexData;
+use gradmesh::internals::catmull_clark;
+use gradmesh::Refinement;
+use gradmesh::VertexData;
 use gradmesh::{ColourSpace, EdgeKind, GradientMesh};
 use kurbo::{Point, Vec2};
 

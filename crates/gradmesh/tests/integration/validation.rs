@@ -1,6 +1,6 @@
 //! Every validation error and warning, produced by a small input, with its message checked.
 
-use gradmesh::mesh::WedgeOverride;
+use gradmesh::WedgeOverride;
 use gradmesh::{validate, ColourSpace, EdgeKind, Error, GradientMesh};
 use kurbo::{Point, Vec2};
 

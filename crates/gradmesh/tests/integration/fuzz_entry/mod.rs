@@ -14,7 +14,7 @@ pub mod render;
 
 use arbitrary::Arbitrary;
 use gradmesh::formats::{self, json, Format};
-use gradmesh::refine::Refinement;
+use gradmesh::Refinement;
 use gradmesh::{
     BoundaryInterpolation, ColourSpace, CreasingMethod, EdgeKind, Error, ErrorKind, GradientMesh,
     Limits, WedgeOverride,
@@ -46,7 +46,7 @@ pub fn parse(format: Format, data: &[u8]) {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    let doc = match formats::read_str_with(text, format, &fuzz_limits()) {
+    let doc = match formats::read_str_with_limits(text, format, &fuzz_limits()) {
         Ok(doc) => doc,
         Err(e) => {
             check_error(&e);
