@@ -51,7 +51,7 @@ pub struct RenderCache {
     /// Per layer, by position: the plans of its regular faces at its last preparation, once
     /// it has been prepared again (edited), which a layer prepared again after an edit takes
     /// for the faces the edit left alone.
-    pub(super) plans: Vec<adaptive::PlanMemo>,
+    pub(super) plans: Vec<adaptive::TessellationCache>,
     /// The last image drawn through the cache: bands that no layer draws differently are
     /// copied from it rather than drawn again.
     pub(super) drawn: Option<Drawn>,

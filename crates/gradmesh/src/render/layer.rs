@@ -460,14 +460,14 @@ pub(crate) type Prepared = (LayerInfo, Option<PreparedLayer>, Vec<Warning>);
 
 /// Prepares layer `index` of a document for drawing, sharing local refinements through
 /// `shapes`, and taking the plans of unchanged regular faces from `memo` (which then holds
-/// this preparation's: see [`adaptive::PlanMemo`]).
+/// this preparation's: see [`adaptive::TessellationCache`]).
 pub(crate) fn prepare(
     mesh: &GradientMesh,
     index: usize,
     opts: &RenderOptions,
     xf: &ToPixels,
     shapes: &ShapeCache,
-    mut memo: Option<&mut adaptive::PlanMemo>,
+    mut memo: Option<&mut adaptive::TessellationCache>,
 ) -> Result<Prepared, Error> {
     if mesh.faces.is_empty() {
         return Ok((LayerInfo::default(), None, Vec::new()));
@@ -520,9 +520,9 @@ pub(crate) fn prepare(
             &th,
             opts.max_level,
             (w, h),
-            adaptive::Kept {
+            adaptive::Caches {
                 shapes,
-                plans: memo.as_deref_mut(),
+                tessellation: memo.as_deref_mut(),
             },
         )
     };

@@ -22,7 +22,7 @@
 //!      count where the surface folds), each edge takes the finer count of its faces, both
 //!      sides use bit-identical samples along it, and the coarser side fans its boundary cells
 //!      out to them. Cells are drawn in the order and with the diagonals of the quads uniform
-//!      refinement would make (see `adaptive.rs`).
+//!      refinement would make (see `adaptive.rs`, `face_plans.rs` and `stitch.rs`).
 //!      A face whose cells fail with linear colour is also measured with *quadratic* colour
 //!      (six-node triangles, see `quadratic.rs`; [`RenderOptions::quadratic`]) against the
 //!      surface at the triangles' quarter points, and keeps whichever passes first: where
@@ -94,6 +94,7 @@ mod adaptive;
 mod cache;
 mod composite;
 mod coverage;
+mod face_plans;
 mod folds;
 mod gamut;
 mod info;
@@ -106,6 +107,7 @@ mod output;
 mod overlay;
 mod patches;
 mod quadratic;
+mod stitch;
 mod triangles;
 mod view;
 #[cfg(target_arch = "x86_64")]

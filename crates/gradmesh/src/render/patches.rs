@@ -361,7 +361,7 @@ struct ShapeDepth {
 /// The local refinement of one shape of neighbourhood, deepened as far as some face asks.
 ///
 /// Its depths are built under a lock, and a [`LocalPatch`] is refined further under its
-/// owner's lock ([`super::adaptive`]): nothing under them waits in rayon (the `_sequential`
+/// owner's lock ([`super::face_plans`]): nothing under them waits in rayon (the `_sequential`
 /// subdivision and stencils), since a thread waiting there may take on a task that wants the
 /// same lock, and deadlock.
 struct LocalShape {

@@ -14,7 +14,7 @@
 //!
 //! Near extraordinary vertices and folds the colour is not smooth enough for the cube: there
 //! the faces stay linear (each face takes whichever passes first, see
-//! [`adaptive`](super::adaptive)).
+//! [`face_plans`](super::face_plans)).
 
 use crate::validate::VertexData;
 
@@ -160,9 +160,9 @@ pub(super) type Cell = [(usize, usize); 4];
 /// `cells` of a face's grid of `n` cells a side, whose nodes come from its grid `g2` of `2 n`
 /// (the same points at even positions), against the samples of its grid `g4` of `4 n` at the
 /// nine quarter points of each triangle (at their true screen positions). `counted[c]`: whether
-/// cell `c`'s colour counts (see [`super::layer::measure_quad`]). `jacobians`: in spaces whose
+/// cell `c`'s colour counts (see [`super::measure::measure_quad`]). `jacobians`: in spaces whose
 /// distances are not Lab's, the derivative to Lab at the points of `g2` (those at the cells'
-/// centres are read), from [`super::adaptive`]'s linear measure. Infinite where a counted
+/// centres are read), from [`super::face_plans`]'s linear measure. Infinite where a counted
 /// triangle has no area on the screen.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn measure_cells(
