@@ -5,8 +5,9 @@
 //! discontinuous edge are separate boundaries with their own colours and handles.
 
 use std::collections::{BTreeMap, HashMap};
+use std::ops::Range;
 
-use kurbo::Vec2;
+use kurbo::{Point, Vec2};
 
 use crate::edit_check::{check_edits, EditSet};
 use crate::error::{Error, ErrorKind, Warning};
@@ -19,8 +20,38 @@ pub use crate::scheme::{
     MAX_HANDLE_RATIO, MAX_INTERPOLATED_MAGNITUDE, MAX_MAGNITUDE, MIN_EDGE_LENGTH,
 };
 
-/// Per-vertex data carried through refinement: `[x, y, c0, c1, c2, opacity]`.
+/// Per-vertex data carried through refinement: `[x, y, c0, c1, c2, opacity]`. A plain array,
+/// not a struct: refinement combines whole rows of them with the same weights.
 pub type VertexData = [f64; 6];
+
+/// Index of x in a [`VertexData`].
+pub const X: usize = 0;
+/// Index of y in a [`VertexData`].
+pub const Y: usize = 1;
+/// Indices of the three colour channels in a [`VertexData`].
+pub const COLOUR: Range<usize> = 2..5;
+/// Index of the opacity in a [`VertexData`].
+pub const OPACITY: usize = 5;
+
+/// The [`VertexData`] of a point at `position` with `colour` and `opacity`.
+pub fn vertex_data(position: Point, colour: [f64; 3], opacity: f64) -> VertexData {
+    let mut d = [0.0; 6];
+    d[X] = position.x;
+    d[Y] = position.y;
+    d[COLOUR].copy_from_slice(&colour);
+    d[OPACITY] = opacity;
+    d
+}
+
+/// The colour and opacity of a [`VertexData`]: the attributes the renderer interpolates.
+pub fn attributes(d: &VertexData) -> [f64; 4] {
+    [
+        d[COLOUR.start],
+        d[COLOUR.start + 1],
+        d[COLOUR.start + 2],
+        d[OPACITY],
+    ]
+}
 
 /// The validated base level: topology with discontinuities split, and the data on it.
 #[derive(Clone, Debug)]
@@ -79,332 +110,437 @@ impl BaseMesh {
     /// Validates `mesh` and builds its base level, with the warnings found.
     pub fn new(mesh: &GradientMesh) -> Result<(BaseMesh, Vec<Warning>), Error> {
         let mut warnings = Vec::new();
-        let warn = |warnings: &mut Vec<Warning>, message: String| {
-            warnings.push(Warning {
-                layer: None,
-                message,
-            })
-        };
         check_numbers(mesh)?;
         let n = mesh.points.len();
 
         // The user's topology, whole: it must be manifold before any cut.
         let (offsets, flat_corners) = flatten(&mesh.faces);
         let whole = Topology::build(n, offsets.clone(), flat_corners.clone(), |_, _| false)?;
-        // Whether points a and b are joined by an edge: a scan of a's ring (no hash table).
-        let has_edge = |a: u32, b: u32| {
-            (a as usize) < n
-                && whole
-                    .vertex_edges(a as usize)
-                    .iter()
-                    .any(|&e| whole.other_vertex(e as usize, a) == b)
-        };
-        for e in 0..whole.edge_count() {
-            let [a, b] = whole.edge_vertices(e);
-            let (p, q) = (
-                mesh.points[a as usize].position,
-                mesh.points[b as usize].position,
-            );
-            if p == q {
-                return Err(ErrorKind::ZeroLengthEdge {
-                    a: a.min(b),
-                    b: a.max(b),
-                    x: p.x,
-                    y: p.y,
-                }
-                .into());
-            }
-            // hypot is at least the larger component: only tiny edges need it.
-            let (dx, dy) = ((q.x - p.x).abs(), (q.y - p.y).abs());
-            let len = if dx.max(dy) >= MIN_EDGE_LENGTH {
-                dx.max(dy)
-            } else {
-                dx.hypot(dy)
-            };
-            if len < MIN_EDGE_LENGTH {
-                return Err(invalid(
-                    format!("edge {}-{}", a.min(b), a.max(b)),
-                    format!("its length {len:e} is below {MIN_EDGE_LENGTH:e}: too short to refine"),
-                ));
-            }
-        }
-        for &(a, b) in mesh.edges.keys() {
-            if !has_edge(a, b) {
-                return Err(ErrorKind::NoSuchEdge {
-                    what: "edge tag".into(),
-                    a,
-                    b,
-                }
-                .into());
-            }
-        }
-        for (&(from, to), h) in &mesh.handles {
-            if !has_edge(from, to) {
-                return Err(ErrorKind::NoSuchEdge {
-                    what: format!("handle of point {from}"),
-                    a: from,
-                    b: to,
-                }
-                .into());
-            }
-            let len = edge_length(mesh, from, to);
-            check_handle_ratio(&format!("handle of point {from} towards {to}"), *h, len)?;
-            if h.hypot() > 0.5 * len * (1.0 + 1e-9) {
-                warn(
-                    &mut warnings,
-                    format!(
-                        "handle of point {from} towards {to} is longer than half its edge ({:.4} > {:.4}): the surface may fold",
-                        h.hypot(),
-                        0.5 * len
-                    ),
-                );
-            }
-        }
+        check_edge_lengths(mesh, &whole)?;
+        check_edge_tags(mesh, &whole)?;
+        check_handles(mesh, &whole, &mut warnings)?;
 
-        // Without discontinuous edges no point is split: the whole topology is the base level.
-        let any_discontinuous = mesh
-            .edges
-            .values()
-            .any(|t| t.kind == EdgeKind::Discontinuous);
-        let is_discontinuous = |a: u32, b: u32| {
-            any_discontinuous
-                && mesh
-                    .edges
-                    .get(&edge_key(a, b))
-                    .is_some_and(|t| t.kind == EdgeKind::Discontinuous)
-        };
-
-        // Wedges: split each point's fan at discontinuous interior edges.
-        // wedge_of_corner[corner] = split vertex index.
-        let mut corner_vertex: Vec<u32> = flat_corners;
-        let mut source_point: Vec<u32> = (0..n as u32).collect();
-        // The number of faces of each split vertex's wedge, to tell whole points from wedges.
-        let mut wedge_face_count: Vec<u32> =
-            (0..n).map(|v| whole.vertex_faces(v).len() as u32).collect();
-        for v in (0..n).filter(|_| any_discontinuous) {
-            let faces = whole.vertex_faces(v);
-            let corners = whole.vertex_face_corners(v);
-            let edges = whole.vertex_edges(v);
-            if faces.is_empty() {
-                continue;
-            }
-            let boundary = whole.is_boundary_vertex(v);
-            let cut_at = |k: usize| {
-                let e = edges[k % edges.len()] as usize;
-                !whole.is_boundary_edge(e) && {
-                    let [a, b] = whole.edge_vertices(e);
-                    is_discontinuous(a, b)
-                }
-            };
-            let cuts: Vec<usize> = (0..faces.len()).filter(|&k| cut_at(k)).collect();
-            // Face k lies between ring edges k and k+1; a new wedge starts at each cut edge.
-            let wedge_count = if boundary {
-                cuts.len() + 1
-            } else {
-                cuts.len().max(1)
-            };
-            let mut wedge_of_face = vec![0usize; faces.len()];
-            if wedge_count > 1 {
-                for (k, w) in wedge_of_face.iter_mut().enumerate() {
-                    // Number of cuts at ring edges <= k (edge k precedes face k).
-                    let c = cuts.iter().filter(|&&e| e <= k).count();
-                    *w = if boundary {
-                        c
-                    } else {
-                        (c + cuts.len() - 1) % cuts.len()
-                    };
-                }
-            }
-            if wedge_count == 1 {
-                continue;
-            }
-            let mut ids = vec![v as u32];
-            wedge_face_count[v] = 0;
-            for _ in 1..wedge_count {
-                ids.push(source_point.len() as u32);
-                source_point.push(v as u32);
-                wedge_face_count.push(0);
-            }
-            for (k, &f) in faces.iter().enumerate() {
-                let id = ids[wedge_of_face[k]];
-                corner_vertex[whole.face_offset(f as usize) + corners[k] as usize] = id;
-                wedge_face_count[id as usize] += 1;
-            }
+        let cuts = Discontinuities::of(mesh);
+        let wedges = Wedges::split(&whole, flat_corners, &cuts);
+        let mut data = wedges.vertex_data(mesh);
+        let override_handles =
+            apply_wedge_entries(mesh, &whole, &wedges, &mut data, &mut warnings)?;
+        // Warned before the split topology is built: a failure there drops every warning.
+        for v in (0..n).filter(|&v| whole.vertex_faces(v).is_empty()) {
+            warn(&mut warnings, format!("point {v} is not used by any face"));
         }
-
-        // Data of each split vertex, with wedge overrides.
-        let split_count = source_point.len();
-        let mut data: Vec<_> = source_point
-            .iter()
-            .map(|&p| {
-                let cp = &mesh.points[p as usize];
-                [
-                    cp.position.x,
-                    cp.position.y,
-                    cp.colour[0],
-                    cp.colour[1],
-                    cp.colour[2],
-                    cp.opacity,
-                ]
-            })
-            .collect();
-        // The split vertex of each (point, face) corner, to find wedge entries in constant time.
-        let mut wedge_at: HashMap<(u32, u32), u32> = HashMap::new();
-        if !mesh.wedges.is_empty() {
-            wedge_at.reserve(corner_vertex.len());
-            for (f, face) in mesh.faces.iter().enumerate() {
-                let o = whole.face_offset(f);
-                for (c, &p) in face.iter().enumerate() {
-                    wedge_at.insert((p, f as u32), corner_vertex[o + c]);
-                }
-            }
-        }
-        let mut override_handles: Vec<Option<&BTreeMap<u32, Vec2>>> = vec![None; split_count];
-        let mut overridden = vec![false; split_count];
-        for (i, w) in mesh.wedges.iter().enumerate() {
-            let what = format!("wedge {i} (point {}, face {})", w.point, w.face);
-            if w.point as usize >= n || w.face as usize >= mesh.faces.len() {
-                return Err(invalid(
-                    what,
-                    "refers to a point or face that does not exist",
-                ));
-            }
-            let Some(id) = wedge_at.get(&(w.point, w.face)).map(|&id| id as usize) else {
-                return Err(invalid(what, "the face does not contain the point"));
-            };
-            if overridden[id] {
-                return Err(invalid(
-                    what,
-                    "another wedge entry already sets this side of the point",
-                ));
-            }
-            overridden[id] = true;
-            let d = &mut data[id];
-            d[2..5].copy_from_slice(&w.colour);
-            if let Some(o) = w.opacity {
-                d[5] = o;
-            }
-            for (&to, &h) in &w.handles {
-                if !has_edge(w.point, to) {
-                    return Err(ErrorKind::NoSuchEdge {
-                        what: format!("handle of {what}"),
-                        a: w.point,
-                        b: to,
-                    }
-                    .into());
-                }
-                check_handle_ratio(
-                    &format!("handle of {what} towards {to}"),
-                    h,
-                    edge_length(mesh, w.point, to),
-                )?;
-            }
-            override_handles[id] = Some(&w.handles);
-            if wedge_face_count[id] as usize == whole.vertex_faces(w.point as usize).len() {
-                warn(
-                    &mut warnings,
-                    format!("{what}: the point is on no discontinuous edge, so the entry recolours it on every side"),
-                );
-            }
-        }
-
-        let unused: Vec<usize> = (0..n)
-            .filter(|&v| whole.vertex_faces(v).is_empty())
-            .collect();
+        let Wedges {
+            corner_vertex,
+            source_point,
+            ..
+        } = wedges;
         // The split topology: discontinuous edges are cut into two boundaries.
-        let topology = if any_discontinuous {
-            Topology::build(split_count, offsets, corner_vertex, |f, c| {
+        let topology = if cuts.any {
+            Topology::build(source_point.len(), offsets, corner_vertex, |f, c| {
                 let face = &mesh.faces[f];
-                is_discontinuous(face[c], face[(c + 1) % face.len()])
+                cuts.between(face[c], face[(c + 1) % face.len()])
             })
             .map_err(Error::from)?
         } else {
             whole
         };
+        let (edge_handles, edge_sharpness) =
+            edge_handles_and_sharpness(mesh, &topology, &source_point, &override_handles);
+        let vertex_sharpness = vertex_sharpness(mesh, &source_point);
+        warn_outside_gamut(mesh, &mut warnings);
 
-        let mut edge_handles = Vec::with_capacity(topology.edge_count());
-        let mut edge_sharpness = Vec::with_capacity(topology.edge_count());
-        for e in 0..topology.edge_count() {
-            let [a, b] = topology.edge_vertices(e);
-            let (pa, pb) = (source_point[a as usize], source_point[b as usize]);
-            let handle = |s: u32, from: u32, to: u32| {
-                override_handles[s as usize]
-                    .and_then(|h| h.get(&to))
-                    .copied()
-                    .unwrap_or_else(|| mesh.handle(from, to))
-            };
-            edge_handles.push([handle(a, pa, pb), handle(b, pb, pa)]);
-            edge_sharpness.push(mesh.edge_tag(pa, pb).effective_sharpness());
-        }
-        let vertex_sharpness = source_point
+        let edits = check_edits(
+            &topology,
+            &source_point,
+            mesh.first_step,
+            &mesh.edits,
+            mesh.fine_edits,
+            mesh.colour_space,
+        )?;
+        let base = BaseMesh {
+            topology,
+            data,
+            source_point,
+            edge_handles,
+            edge_sharpness,
+            vertex_sharpness,
+            boundary: mesh.boundary,
+            creasing: mesh.creasing,
+            interpolate_positions: mesh.interpolate_positions,
+            first_step: mesh.first_step,
+            edits,
+        };
+        Ok((base, warnings))
+    }
+}
+
+fn warn(warnings: &mut Vec<Warning>, message: String) {
+    warnings.push(Warning {
+        layer: None,
+        message,
+    })
+}
+
+/// Whether points `a` and `b` are joined by an edge of `whole`: a scan of `a`'s ring (no hash
+/// table).
+fn has_edge(whole: &Topology, a: u32, b: u32) -> bool {
+    (a as usize) < whole.vertex_count()
+        && whole
+            .vertex_edges(a as usize)
             .iter()
-            .map(|&p| {
-                if mesh.points[p as usize].corner {
-                    crate::mesh::SHARPNESS_INFINITE
-                } else {
-                    0.0
-                }
-            })
-            .collect();
+            .any(|&e| whole.other_vertex(e as usize, a) == b)
+}
 
-        for v in unused {
-            warn(&mut warnings, format!("point {v} is not used by any face"));
-        }
-        // One warning per point for the first few; a count for the rest (a mesh made in a wide
-        // space may have thousands, and formatting them cost a tenth of validation).
-        let mut outside = 0usize;
-        for (v, p) in mesh.points.iter().enumerate() {
-            if !mesh.colour_space.in_srgb_gamut(p.colour) {
-                outside += 1;
-                if outside <= GAMUT_WARNINGS_LISTED {
-                    warn(
-                        &mut warnings,
-                        format!(
-                            "point {v}: colour {:?} ({}) is outside the sRGB gamut",
-                            p.colour,
-                            mesh.colour_space.name()
-                        ),
-                    );
-                }
+/// Refuses edges of zero length or too short to refine.
+fn check_edge_lengths(mesh: &GradientMesh, whole: &Topology) -> Result<(), Error> {
+    for e in 0..whole.edge_count() {
+        let [a, b] = whole.edge_vertices(e);
+        let (p, q) = (
+            mesh.points[a as usize].position,
+            mesh.points[b as usize].position,
+        );
+        if p == q {
+            return Err(ErrorKind::ZeroLengthEdge {
+                a: a.min(b),
+                b: a.max(b),
+                x: p.x,
+                y: p.y,
             }
+            .into());
         }
-        if outside > GAMUT_WARNINGS_LISTED {
+        // hypot is at least the larger component: only tiny edges need it.
+        let (dx, dy) = ((q.x - p.x).abs(), (q.y - p.y).abs());
+        let len = if dx.max(dy) >= MIN_EDGE_LENGTH {
+            dx.max(dy)
+        } else {
+            dx.hypot(dy)
+        };
+        if len < MIN_EDGE_LENGTH {
+            return Err(invalid(
+                format!("edge {}-{}", a.min(b), a.max(b)),
+                format!("its length {len:e} is below {MIN_EDGE_LENGTH:e}: too short to refine"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Refuses edge tags on pairs of points that no face edge joins.
+fn check_edge_tags(mesh: &GradientMesh, whole: &Topology) -> Result<(), Error> {
+    for &(a, b) in mesh.edges.keys() {
+        if !has_edge(whole, a, b) {
+            return Err(ErrorKind::NoSuchEdge {
+                what: "edge tag".into(),
+                a,
+                b,
+            }
+            .into());
+        }
+    }
+    Ok(())
+}
+
+/// Refuses handles off the mesh's edges or far too long, and warns of those that may fold the
+/// surface.
+fn check_handles(
+    mesh: &GradientMesh,
+    whole: &Topology,
+    warnings: &mut Vec<Warning>,
+) -> Result<(), Error> {
+    for (&(from, to), h) in &mesh.handles {
+        if !has_edge(whole, from, to) {
+            return Err(ErrorKind::NoSuchEdge {
+                what: format!("handle of point {from}"),
+                a: from,
+                b: to,
+            }
+            .into());
+        }
+        let len = edge_length(mesh, from, to);
+        check_handle_ratio(&format!("handle of point {from} towards {to}"), *h, len)?;
+        if h.hypot() > 0.5 * len * (1.0 + 1e-9) {
             warn(
-                &mut warnings,
+                warnings,
                 format!(
-                    "{} more points have colours outside the sRGB gamut",
-                    outside - GAMUT_WARNINGS_LISTED
+                    "handle of point {from} towards {to} is longer than half its edge ({:.4} > {:.4}): the surface may fold",
+                    h.hypot(),
+                    0.5 * len
                 ),
             );
         }
+    }
+    Ok(())
+}
 
-        Ok((
-            BaseMesh {
-                topology,
-                data,
-                source_point,
-                edge_handles,
-                edge_sharpness,
-                vertex_sharpness,
-                boundary: mesh.boundary,
-                creasing: mesh.creasing,
-                interpolate_positions: mesh.interpolate_positions,
-                first_step: mesh.first_step,
-                edits: EditSet::default(),
-            },
-            warnings,
-        ))
-        .and_then(|(mut base, warnings)| {
-            base.edits = check_edits(
-                &base.topology,
-                &base.source_point,
-                base.first_step,
-                &mesh.edits,
-                mesh.fine_edits,
-                mesh.colour_space,
-            )?;
-            Ok((base, warnings))
+/// The discontinuous edges of a mesh.
+struct Discontinuities<'a> {
+    mesh: &'a GradientMesh,
+    /// Whether there is any: without, no point is split and the whole topology is the base
+    /// level.
+    any: bool,
+}
+
+impl<'a> Discontinuities<'a> {
+    fn of(mesh: &'a GradientMesh) -> Self {
+        let any = mesh
+            .edges
+            .values()
+            .any(|t| t.kind == EdgeKind::Discontinuous);
+        Discontinuities { mesh, any }
+    }
+
+    /// Whether the edge between points `a` and `b` is discontinuous.
+    fn between(&self, a: u32, b: u32) -> bool {
+        self.any
+            && self
+                .mesh
+                .edges
+                .get(&edge_key(a, b))
+                .is_some_and(|t| t.kind == EdgeKind::Discontinuous)
+    }
+}
+
+/// The points split into one vertex per wedge: each point's fan cut at its discontinuous
+/// interior edges. Points keep their index; extra wedges are appended.
+struct Wedges {
+    /// The split vertex at each flat corner of the faces.
+    corner_vertex: Vec<u32>,
+    /// The point each split vertex comes from.
+    source_point: Vec<u32>,
+    /// The number of faces of each split vertex's wedge, to tell whole points from wedges.
+    face_count: Vec<u32>,
+}
+
+impl Wedges {
+    fn split(whole: &Topology, flat_corners: Vec<u32>, cuts: &Discontinuities) -> Wedges {
+        let n = whole.vertex_count();
+        let mut wedges = Wedges {
+            corner_vertex: flat_corners,
+            source_point: (0..n as u32).collect(),
+            face_count: (0..n).map(|v| whole.vertex_faces(v).len() as u32).collect(),
+        };
+        for v in (0..n).filter(|_| cuts.any) {
+            wedges.split_point(whole, v, cuts);
+        }
+        wedges
+    }
+
+    /// Splits point `v` into its wedges, if it has more than one.
+    fn split_point(&mut self, whole: &Topology, v: usize, cuts: &Discontinuities) {
+        let faces = whole.vertex_faces(v);
+        let corners = whole.vertex_face_corners(v);
+        if faces.is_empty() {
+            return;
+        }
+        let Some((wedge_count, wedge_of_face)) = wedge_of_each_face(whole, v, cuts) else {
+            return;
+        };
+        let mut ids = vec![v as u32];
+        self.face_count[v] = 0;
+        for _ in 1..wedge_count {
+            ids.push(self.source_point.len() as u32);
+            self.source_point.push(v as u32);
+            self.face_count.push(0);
+        }
+        for (k, &f) in faces.iter().enumerate() {
+            let id = ids[wedge_of_face[k]];
+            self.corner_vertex[whole.face_offset(f as usize) + corners[k] as usize] = id;
+            self.face_count[id as usize] += 1;
+        }
+    }
+
+    /// Position, colour and opacity of each split vertex, from its point.
+    fn vertex_data(&self, mesh: &GradientMesh) -> Vec<VertexData> {
+        self.source_point
+            .iter()
+            .map(|&p| {
+                let cp = &mesh.points[p as usize];
+                vertex_data(cp.position, cp.colour, cp.opacity)
+            })
+            .collect()
+    }
+}
+
+/// The number of wedges of point `v`, and the wedge of each face around it in ring order;
+/// `None` when the point has one wedge only.
+fn wedge_of_each_face(
+    whole: &Topology,
+    v: usize,
+    cuts: &Discontinuities,
+) -> Option<(usize, Vec<usize>)> {
+    let faces = whole.vertex_faces(v);
+    let edges = whole.vertex_edges(v);
+    let boundary = whole.is_boundary_vertex(v);
+    let cut_at = |k: usize| {
+        let e = edges[k % edges.len()] as usize;
+        !whole.is_boundary_edge(e) && {
+            let [a, b] = whole.edge_vertices(e);
+            cuts.between(a, b)
+        }
+    };
+    let cut_edges: Vec<usize> = (0..faces.len()).filter(|&k| cut_at(k)).collect();
+    // Face k lies between ring edges k and k+1; a new wedge starts at each cut edge.
+    let wedge_count = if boundary {
+        cut_edges.len() + 1
+    } else {
+        cut_edges.len().max(1)
+    };
+    if wedge_count == 1 {
+        return None;
+    }
+    let wedge_of_face = (0..faces.len())
+        .map(|k| {
+            // Number of cuts at ring edges <= k (edge k precedes face k).
+            let c = cut_edges.iter().filter(|&&e| e <= k).count();
+            if boundary {
+                c
+            } else {
+                (c + cut_edges.len() - 1) % cut_edges.len()
+            }
         })
+        .collect();
+    Some((wedge_count, wedge_of_face))
+}
+
+/// Applies the mesh's wedge entries (colour, opacity, handles of one side of a point) to
+/// `data`; returns the handles each split vertex takes from an entry.
+fn apply_wedge_entries<'m>(
+    mesh: &'m GradientMesh,
+    whole: &Topology,
+    wedges: &Wedges,
+    data: &mut [VertexData],
+    warnings: &mut Vec<Warning>,
+) -> Result<Vec<Option<&'m BTreeMap<u32, Vec2>>>, Error> {
+    let (n, split_count) = (mesh.points.len(), wedges.source_point.len());
+    // The split vertex of each (point, face) corner, to find wedge entries in constant time.
+    let mut wedge_at: HashMap<(u32, u32), u32> = HashMap::new();
+    if !mesh.wedges.is_empty() {
+        wedge_at.reserve(wedges.corner_vertex.len());
+        for (f, face) in mesh.faces.iter().enumerate() {
+            let o = whole.face_offset(f);
+            for (c, &p) in face.iter().enumerate() {
+                wedge_at.insert((p, f as u32), wedges.corner_vertex[o + c]);
+            }
+        }
+    }
+    let mut override_handles: Vec<Option<&BTreeMap<u32, Vec2>>> = vec![None; split_count];
+    let mut overridden = vec![false; split_count];
+    for (i, w) in mesh.wedges.iter().enumerate() {
+        let what = format!("wedge {i} (point {}, face {})", w.point, w.face);
+        if w.point as usize >= n || w.face as usize >= mesh.faces.len() {
+            return Err(invalid(
+                what,
+                "refers to a point or face that does not exist",
+            ));
+        }
+        let Some(id) = wedge_at.get(&(w.point, w.face)).map(|&id| id as usize) else {
+            return Err(invalid(what, "the face does not contain the point"));
+        };
+        if overridden[id] {
+            return Err(invalid(
+                what,
+                "another wedge entry already sets this side of the point",
+            ));
+        }
+        overridden[id] = true;
+        let d = &mut data[id];
+        d[COLOUR].copy_from_slice(&w.colour);
+        if let Some(o) = w.opacity {
+            d[OPACITY] = o;
+        }
+        for (&to, &h) in &w.handles {
+            if !has_edge(whole, w.point, to) {
+                return Err(ErrorKind::NoSuchEdge {
+                    what: format!("handle of {what}"),
+                    a: w.point,
+                    b: to,
+                }
+                .into());
+            }
+            check_handle_ratio(
+                &format!("handle of {what} towards {to}"),
+                h,
+                edge_length(mesh, w.point, to),
+            )?;
+        }
+        override_handles[id] = Some(&w.handles);
+        if wedges.face_count[id] as usize == whole.vertex_faces(w.point as usize).len() {
+            warn(
+                warnings,
+                format!("{what}: the point is on no discontinuous edge, so the entry recolours it on every side"),
+            );
+        }
+    }
+    Ok(override_handles)
+}
+
+/// The handles and sharpness of each edge of the split `topology`; a wedge entry's handles
+/// take the place of its point's.
+fn edge_handles_and_sharpness(
+    mesh: &GradientMesh,
+    topology: &Topology,
+    source_point: &[u32],
+    override_handles: &[Option<&BTreeMap<u32, Vec2>>],
+) -> (Vec<[Vec2; 2]>, Vec<f64>) {
+    let mut edge_handles = Vec::with_capacity(topology.edge_count());
+    let mut edge_sharpness = Vec::with_capacity(topology.edge_count());
+    for e in 0..topology.edge_count() {
+        let [a, b] = topology.edge_vertices(e);
+        let (pa, pb) = (source_point[a as usize], source_point[b as usize]);
+        let handle = |s: u32, from: u32, to: u32| {
+            override_handles[s as usize]
+                .and_then(|h| h.get(&to))
+                .copied()
+                .unwrap_or_else(|| mesh.handle(from, to))
+        };
+        edge_handles.push([handle(a, pa, pb), handle(b, pb, pa)]);
+        edge_sharpness.push(mesh.edge_tag(pa, pb).effective_sharpness());
+    }
+    (edge_handles, edge_sharpness)
+}
+
+/// The sharpness of each split vertex: infinite at corners.
+fn vertex_sharpness(mesh: &GradientMesh, source_point: &[u32]) -> Vec<f64> {
+    source_point
+        .iter()
+        .map(|&p| {
+            if mesh.points[p as usize].corner {
+                crate::mesh::SHARPNESS_INFINITE
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+/// Warns of colours outside the sRGB gamut: one warning per point for the first few, a count
+/// for the rest (a mesh made in a wide space may have thousands, and formatting them all is
+/// a noticeable part of validation).
+fn warn_outside_gamut(mesh: &GradientMesh, warnings: &mut Vec<Warning>) {
+    let mut outside = 0usize;
+    for (v, p) in mesh.points.iter().enumerate() {
+        if !mesh.colour_space.in_srgb_gamut(p.colour) {
+            outside += 1;
+            if outside <= GAMUT_WARNINGS_LISTED {
+                warn(
+                    warnings,
+                    format!(
+                        "point {v}: colour {:?} ({}) is outside the sRGB gamut",
+                        p.colour,
+                        mesh.colour_space.name()
+                    ),
+                );
+            }
+        }
+    }
+    if outside > GAMUT_WARNINGS_LISTED {
+        warn(
+            warnings,
+            format!(
+                "{} more points have colours outside the sRGB gamut",
+                outside - GAMUT_WARNINGS_LISTED
+            ),
+        );
     }
 }
 

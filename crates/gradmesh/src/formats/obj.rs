@@ -156,18 +156,44 @@ pub fn read_obj(text: &str) -> Result<GradientMesh, Error> {
 pub fn read_obj_with(text: &str, limits: &Limits) -> Result<GradientMesh, Error> {
     check_size(text.len() as u64, limits.input_bytes)?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut mesh = GradientMesh::new(ColourSpace::Srgb);
-    // Whether vertices carry colours, with the line of the first vertex.
-    let mut coloured: Option<(bool, usize)> = None;
-    // Face corners with positive indices are checked once every vertex is known.
-    let mut face_lines: Vec<usize> = Vec::new();
-    // (a, b, sharpness, line) and (vertex, sharpness, line), applied at the end.
-    let mut creases: Vec<(u32, u32, f64, usize)> = Vec::new();
-    let mut corners: Vec<(u32, f64, usize)> = Vec::new();
-    let mut corner_count = 0u64;
-
+    let mut reader = ObjReader::new(limits);
     for (i, raw) in text.lines().enumerate() {
-        let line = i + 1;
+        reader.read_line(i + 1, raw)?;
+    }
+    reader.finish()
+}
+
+/// What has been read of an OBJ file so far.
+struct ObjReader<'l> {
+    limits: &'l Limits,
+    mesh: GradientMesh,
+    /// Whether vertices carry colours, with the line of the first vertex.
+    coloured: Option<(bool, usize)>,
+    /// The line of each face: corners with positive indices are checked once every vertex is
+    /// known.
+    face_lines: Vec<usize>,
+    /// Crease tags `(a, b, sharpness, line)`, applied at the end.
+    creases: Vec<(u32, u32, f64, usize)>,
+    /// Corner tags `(vertex, sharpness, line)`, applied at the end.
+    corners: Vec<(u32, f64, usize)>,
+    corner_count: u64,
+}
+
+impl<'l> ObjReader<'l> {
+    fn new(limits: &'l Limits) -> Self {
+        ObjReader {
+            limits,
+            mesh: GradientMesh::new(ColourSpace::Srgb),
+            coloured: None,
+            face_lines: Vec::new(),
+            creases: Vec::new(),
+            corners: Vec::new(),
+            corner_count: 0,
+        }
+    }
+
+    /// Reads line number `line`, whose text is `raw`.
+    fn read_line(&mut self, line: usize, raw: &str) -> Result<(), Error> {
         let content = raw.split('#').next().unwrap_or("");
         if content.trim_end().ends_with('\\') {
             return Err(syntax_error(
@@ -177,274 +203,307 @@ pub fn read_obj_with(text: &str, limits: &Limits) -> Result<GradientMesh, Error>
         }
         let t: Vec<&str> = content.split_whitespace().collect();
         let Some(&keyword) = t.first() else {
-            continue;
+            return Ok(());
         };
         match keyword {
-            "v" => {
-                let v = mesh.points.len();
-                check_count("the number of vertices", v as u64 + 1, limits.points)
-                    .map_err(|e| located(e, line))?;
-                let values: Vec<f64> = t[1..]
-                    .iter()
-                    .enumerate()
-                    .map(|(k, s)| {
-                        parse_num(s, || format!("vertex {} value {}", v + 1, k + 1), line)
-                    })
-                    .collect::<Result<_, _>>()?;
-                let has_colour = match values.len() {
-                    3 => false,
-                    6 => true,
-                    n => {
-                        return Err(syntax_error(
-                            line,
-                            format!(
-                            "vertex {}: expected \"x y z\" or \"x y z r g b\", found {n} numbers",
-                            v + 1
-                        ),
-                        ))
-                    }
-                };
-                match coloured {
-                    None => coloured = Some((has_colour, line)),
-                    Some((c, first)) if c != has_colour => {
-                        let (this, that) = if has_colour {
-                            ("has a colour", "has none")
-                        } else {
-                            ("has no colour", "has one")
-                        };
-                        return Err(syntax_error(
-                            line,
-                            format!(
-                                "vertex {} {this}, but the first vertex (line {first}) {that}: \
-                                 give every vertex a colour or none",
-                                v + 1
-                            ),
-                        ));
-                    }
-                    Some(_) => {}
-                }
-                let colour = if has_colour {
-                    [values[3], values[4], values[5]]
-                } else {
-                    NEUTRAL_GREY
-                };
-                mesh.points
-                    .push(ControlPoint::new(Point::new(values[0], values[1]), colour));
-            }
-            "f" => {
-                let f = mesh.faces.len();
-                check_count("the number of faces", f as u64 + 1, limits.faces)
-                    .map_err(|e| located(e, line))?;
-                corner_count += t.len() as u64 - 1;
-                check_count("the number of corners", corner_count, limits.corners)
-                    .map_err(|e| located(e, line))?;
-                if t.len() < 4 {
-                    return Err(syntax_error(
-                        line,
-                        format!(
-                            "face {}: expected at least 3 corners, found {}",
-                            f + 1,
-                            t.len() - 1
-                        ),
-                    ));
-                }
-                let mut face = Vec::with_capacity(t.len() - 1);
-                // A set, not a search of the corners so far: faces may have millions of corners.
-                let mut seen = std::collections::HashSet::with_capacity(t.len() - 1);
-                for (c, token) in t[1..].iter().enumerate() {
-                    let first = token.split('/').next().unwrap_or("");
-                    let index: i64 = first.parse().map_err(|_| {
-                        syntax_error(
-                            line,
-                            format!(
-                                "face {}: corner {}: expected a vertex index, found \"{token}\"",
-                                f + 1,
-                                c + 1
-                            ),
-                        )
-                    })?;
-                    let count = mesh.points.len() as i64;
-                    let resolved = match index {
-                        0 => {
-                            return Err(syntax_error(
-                                line,
-                                format!(
-                                    "face {}: corner {}: expected an index from 1 (or negative), found 0",
-                                    f + 1,
-                                    c + 1
-                                ),
-                            ))
-                        }
-                        i if i < 0 && i + count < 0 => {
-                            return Err(syntax_error(
-                                line,
-                                format!(
-                                    "face {}: corner {}: relative index {i} reaches before the first vertex \
-                                     ({count} vertices read so far)",
-                                    f + 1,
-                                    c + 1
-                                ),
-                            ))
-                        }
-                        i if i < 0 => i + count,
-                        i => i - 1,
-                    };
-                    let Ok(resolved) = u32::try_from(resolved) else {
-                        return Err(syntax_error(
-                            line,
-                            format!(
-                                "face {}: corner {}: index {index} is too large",
-                                f + 1,
-                                c + 1
-                            ),
-                        ));
-                    };
-                    if !seen.insert(resolved) {
-                        return Err(syntax_error(
-                            line,
-                            format!(
-                                "face {}: vertex {} appears twice",
-                                f + 1,
-                                u64::from(resolved) + 1
-                            ),
-                        ));
-                    }
-                    face.push(resolved);
-                }
-                mesh.faces.push(face);
-                face_lines.push(line);
-            }
-            "t" => {
-                let tag = parse_tag(&t, line)?;
-                match tag.name {
-                    "crease" => {
-                        if tag.ints.len() < 2 || tag.ints.len() % 2 != 0 {
-                            return Err(syntax_error(
-                                line,
-                                format!(
-                                    "tag crease: expected pairs of vertex indices, found {} integers",
-                                    tag.ints.len()
-                                ),
-                            ));
-                        }
-                        let pairs = tag.ints.len() / 2;
-                        for k in 0..pairs {
-                            let s = tag_sharpness(&tag, pairs, k, line)?;
-                            creases.push((tag.ints[2 * k], tag.ints[2 * k + 1], s, line));
-                        }
-                    }
-                    "corner" => {
-                        if tag.ints.is_empty() {
-                            return Err(syntax_error(
-                                line,
-                                "tag corner: expected at least one vertex index",
-                            ));
-                        }
-                        for (k, &v) in tag.ints.iter().enumerate() {
-                            let s = tag_sharpness(&tag, tag.ints.len(), k, line)?;
-                            corners.push((v, s, line));
-                        }
-                    }
-                    "interpolateboundary" => {
-                        mesh.boundary = match tag.ints.as_slice() {
-                            [1] => BoundaryInterpolation::EdgeAndCorner,
-                            [2] => BoundaryInterpolation::EdgeOnly,
-                            other => {
-                                return Err(syntax_error(
-                                    line,
-                                    format!(
-                                        "tag interpolateboundary: expected 1 (edge and corner) or 2 \
-                                         (edge only), found {other:?}"
-                                    ),
-                                ))
-                            }
-                        }
-                    }
-                    "creasemethod" => {
-                        mesh.creasing = match tag.strings.as_slice() {
-                            ["normal"] | ["uniform"] => CreasingMethod::Uniform,
-                            ["chaikin"] => CreasingMethod::Chaikin,
-                            other => {
-                                return Err(syntax_error(
-                                    line,
-                                    format!(
-                                        "tag creasemethod: expected \"normal\" or \"chaikin\", found {other:?}"
-                                    ),
-                                ))
-                            }
-                        }
-                    }
-                    "smoothtriangles" if tag.strings == ["catmark"] => {}
-                    name if IGNORED_TAGS.contains(&name) => {}
-                    name => {
-                        return Err(syntax_error(
-                            line,
-                            format!(
-                                "tag {name}: not supported (supported: crease, corner, \
-                                 interpolateboundary, creasemethod)"
-                            ),
-                        ))
-                    }
-                }
-            }
-            k if IGNORED.contains(&k) => {}
-            other => {
-                return Err(syntax_error(
-                    line,
-                    format!("unknown statement \"{other}\" (expected v, f or t)"),
-                ))
-            }
+            "v" => self.read_vertex(&t, line),
+            "f" => self.read_face(&t, line),
+            "t" => self.read_tag(&t, line),
+            k if IGNORED.contains(&k) => Ok(()),
+            other => Err(syntax_error(
+                line,
+                format!("unknown statement \"{other}\" (expected v, f or t)"),
+            )),
         }
     }
 
-    let n = mesh.points.len();
-    for (f, face) in mesh.faces.iter().enumerate() {
-        for (c, &v) in face.iter().enumerate() {
-            if v as usize >= n {
+    /// `v x y z [r g b]`.
+    fn read_vertex(&mut self, t: &[&str], line: usize) -> Result<(), Error> {
+        let v = self.mesh.points.len();
+        check_count("the number of vertices", v as u64 + 1, self.limits.points)
+            .map_err(|e| located(e, line))?;
+        let values: Vec<f64> = t[1..]
+            .iter()
+            .enumerate()
+            .map(|(k, s)| parse_num(s, || format!("vertex {} value {}", v + 1, k + 1), line))
+            .collect::<Result<_, _>>()?;
+        let has_colour = match values.len() {
+            3 => false,
+            6 => true,
+            n => {
                 return Err(syntax_error(
-                    face_lines[f],
+                    line,
                     format!(
-                        "face {}: corner {} refers to vertex {}, but there are only {n} vertices",
-                        f + 1,
-                        c + 1,
-                        u64::from(v) + 1
+                        "vertex {}: expected \"x y z\" or \"x y z r g b\", found {n} numbers",
+                        v + 1
+                    ),
+                ))
+            }
+        };
+        match self.coloured {
+            None => self.coloured = Some((has_colour, line)),
+            Some((c, first)) if c != has_colour => {
+                let (this, that) = if has_colour {
+                    ("has a colour", "has none")
+                } else {
+                    ("has no colour", "has one")
+                };
+                return Err(syntax_error(
+                    line,
+                    format!(
+                        "vertex {} {this}, but the first vertex (line {first}) {that}: \
+                         give every vertex a colour or none",
+                        v + 1
                     ),
                 ));
             }
+            Some(_) => {}
         }
-    }
-    let check_tag_vertex = |v: u32, tag: &str, line: usize| {
-        if v as usize >= n {
-            Err(syntax_error(
-                line,
-                format!("tag {tag}: vertex {v} (0-based) does not exist (there are {n} vertices)"),
-            ))
+        let colour = if has_colour {
+            [values[3], values[4], values[5]]
         } else {
-            Ok(())
-        }
-    };
-    for (a, b, s, line) in creases {
-        check_tag_vertex(a, "crease", line)?;
-        check_tag_vertex(b, "crease", line)?;
-        if a == b {
+            NEUTRAL_GREY
+        };
+        self.mesh
+            .points
+            .push(ControlPoint::new(Point::new(values[0], values[1]), colour));
+        Ok(())
+    }
+
+    /// `f v1 v2 v3 ..`, each corner in one of the forms `v`, `v/vt`, `v//vn`, `v/vt/vn`.
+    fn read_face(&mut self, t: &[&str], line: usize) -> Result<(), Error> {
+        let f = self.mesh.faces.len();
+        check_count("the number of faces", f as u64 + 1, self.limits.faces)
+            .map_err(|e| located(e, line))?;
+        self.corner_count += t.len() as u64 - 1;
+        check_count(
+            "the number of corners",
+            self.corner_count,
+            self.limits.corners,
+        )
+        .map_err(|e| located(e, line))?;
+        if t.len() < 4 {
             return Err(syntax_error(
                 line,
-                format!("tag crease: the edge {a}-{b} joins a vertex to itself"),
+                format!(
+                    "face {}: expected at least 3 corners, found {}",
+                    f + 1,
+                    t.len() - 1
+                ),
             ));
         }
-        // As in OpenSubdiv, a later tag on the same edge wins, and sharpness 0 is smooth.
-        let kind = if s > 0.0 {
-            EdgeKind::Crease
-        } else {
-            EdgeKind::Smooth
+        let mut face = Vec::with_capacity(t.len() - 1);
+        // A set, not a search of the corners so far: faces may have millions of corners.
+        let mut seen = std::collections::HashSet::with_capacity(t.len() - 1);
+        let count = self.mesh.points.len() as i64;
+        for (c, token) in t[1..].iter().enumerate() {
+            let resolved = face_corner(token, f, c, count, line)?;
+            if !seen.insert(resolved) {
+                return Err(syntax_error(
+                    line,
+                    format!(
+                        "face {}: vertex {} appears twice",
+                        f + 1,
+                        u64::from(resolved) + 1
+                    ),
+                ));
+            }
+            face.push(resolved);
+        }
+        self.mesh.faces.push(face);
+        self.face_lines.push(line);
+        Ok(())
+    }
+
+    /// `t name ints/floats/strings args..`: OpenSubdiv's tags.
+    fn read_tag(&mut self, t: &[&str], line: usize) -> Result<(), Error> {
+        let tag = parse_tag(t, line)?;
+        match tag.name {
+            "crease" => {
+                if tag.ints.len() < 2 || tag.ints.len() % 2 != 0 {
+                    return Err(syntax_error(
+                        line,
+                        format!(
+                            "tag crease: expected pairs of vertex indices, found {} integers",
+                            tag.ints.len()
+                        ),
+                    ));
+                }
+                let pairs = tag.ints.len() / 2;
+                for k in 0..pairs {
+                    let s = tag_sharpness(&tag, pairs, k, line)?;
+                    self.creases
+                        .push((tag.ints[2 * k], tag.ints[2 * k + 1], s, line));
+                }
+            }
+            "corner" => {
+                if tag.ints.is_empty() {
+                    return Err(syntax_error(
+                        line,
+                        "tag corner: expected at least one vertex index",
+                    ));
+                }
+                for (k, &v) in tag.ints.iter().enumerate() {
+                    let s = tag_sharpness(&tag, tag.ints.len(), k, line)?;
+                    self.corners.push((v, s, line));
+                }
+            }
+            "interpolateboundary" => {
+                self.mesh.boundary = match tag.ints.as_slice() {
+                    [1] => BoundaryInterpolation::EdgeAndCorner,
+                    [2] => BoundaryInterpolation::EdgeOnly,
+                    other => {
+                        return Err(syntax_error(
+                            line,
+                            format!(
+                                "tag interpolateboundary: expected 1 (edge and corner) or 2 \
+                                 (edge only), found {other:?}"
+                            ),
+                        ))
+                    }
+                }
+            }
+            "creasemethod" => {
+                self.mesh.creasing = match tag.strings.as_slice() {
+                    ["normal"] | ["uniform"] => CreasingMethod::Uniform,
+                    ["chaikin"] => CreasingMethod::Chaikin,
+                    other => {
+                        return Err(syntax_error(
+                            line,
+                            format!(
+                            "tag creasemethod: expected \"normal\" or \"chaikin\", found {other:?}"
+                        ),
+                        ))
+                    }
+                }
+            }
+            "smoothtriangles" if tag.strings == ["catmark"] => {}
+            name if IGNORED_TAGS.contains(&name) => {}
+            name => {
+                return Err(syntax_error(
+                    line,
+                    format!(
+                        "tag {name}: not supported (supported: crease, corner, \
+                         interpolateboundary, creasemethod)"
+                    ),
+                ))
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks the faces' corners and the tags' vertices against the vertices read, and
+    /// applies the tags.
+    fn finish(self) -> Result<GradientMesh, Error> {
+        let ObjReader {
+            mut mesh,
+            face_lines,
+            creases,
+            corners,
+            ..
+        } = self;
+        let n = mesh.points.len();
+        for (f, face) in mesh.faces.iter().enumerate() {
+            for (c, &v) in face.iter().enumerate() {
+                if v as usize >= n {
+                    return Err(syntax_error(
+                        face_lines[f],
+                        format!(
+                            "face {}: corner {} refers to vertex {}, but there are only {n} vertices",
+                            f + 1,
+                            c + 1,
+                            u64::from(v) + 1
+                        ),
+                    ));
+                }
+            }
+        }
+        let check_tag_vertex = |v: u32, tag: &str, line: usize| {
+            if v as usize >= n {
+                Err(syntax_error(
+                    line,
+                    format!(
+                        "tag {tag}: vertex {v} (0-based) does not exist (there are {n} vertices)"
+                    ),
+                ))
+            } else {
+                Ok(())
+            }
         };
-        mesh.set_edge(a, b, kind, Some(s));
+        for (a, b, s, line) in creases {
+            check_tag_vertex(a, "crease", line)?;
+            check_tag_vertex(b, "crease", line)?;
+            if a == b {
+                return Err(syntax_error(
+                    line,
+                    format!("tag crease: the edge {a}-{b} joins a vertex to itself"),
+                ));
+            }
+            // As in OpenSubdiv, a later tag on the same edge wins, and sharpness 0 is smooth.
+            let kind = if s > 0.0 {
+                EdgeKind::Crease
+            } else {
+                EdgeKind::Smooth
+            };
+            mesh.set_edge(a, b, kind, Some(s));
+        }
+        for (v, s, line) in corners {
+            check_tag_vertex(v, "corner", line)?;
+            mesh.points[v as usize].corner = s > 0.0;
+        }
+        Ok(mesh)
     }
-    for (v, s, line) in corners {
-        check_tag_vertex(v, "corner", line)?;
-        mesh.points[v as usize].corner = s > 0.0;
-    }
-    Ok(mesh)
+}
+
+/// The 0-based vertex of corner `c` of face `f` (both 0-based) from its token, with `count`
+/// vertices read so far: 1-based, or negative to count back from the last vertex read.
+fn face_corner(token: &str, f: usize, c: usize, count: i64, line: usize) -> Result<u32, Error> {
+    let first = token.split('/').next().unwrap_or("");
+    let index: i64 = first.parse().map_err(|_| {
+        syntax_error(
+            line,
+            format!(
+                "face {}: corner {}: expected a vertex index, found \"{token}\"",
+                f + 1,
+                c + 1
+            ),
+        )
+    })?;
+    let resolved = match index {
+        0 => {
+            return Err(syntax_error(
+                line,
+                format!(
+                    "face {}: corner {}: expected an index from 1 (or negative), found 0",
+                    f + 1,
+                    c + 1
+                ),
+            ))
+        }
+        i if i < 0 && i + count < 0 => {
+            return Err(syntax_error(
+                line,
+                format!(
+                    "face {}: corner {}: relative index {i} reaches before the first vertex \
+                     ({count} vertices read so far)",
+                    f + 1,
+                    c + 1
+                ),
+            ))
+        }
+        i if i < 0 => i + count,
+        i => i - 1,
+    };
+    u32::try_from(resolved).map_err(|_| {
+        syntax_error(
+            line,
+            format!(
+                "face {}: corner {}: index {index} is too large",
+                f + 1,
+                c + 1
+            ),
+        )
+    })
 }
 
 fn located(mut e: Error, line: usize) -> Error {

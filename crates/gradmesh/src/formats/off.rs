@@ -53,6 +53,14 @@ impl<'a> Lines<'a> {
         }
         None
     }
+
+    /// The error for a file that ends where `expected` should follow.
+    fn eof(&self, expected: String) -> Error {
+        syntax_error(
+            self.last.max(1),
+            format!("unexpected end of file: expected {expected}"),
+        )
+    }
 }
 
 // `what` names the field for an error message: built only when there is one (formatting it
@@ -106,27 +114,66 @@ pub fn read_off_with(text: &str, limits: &Limits) -> Result<GradientMesh, Error>
     check_size(text.len() as u64, limits.input_bytes)?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut lines = Lines::new(text);
-    let eof = |lines: &Lines, expected: String| {
-        syntax_error(
-            lines.last.max(1),
-            format!("unexpected end of file: expected {expected}"),
-        )
-    };
+    read_off_line(&mut lines)?;
+    let (nv, nf, colour_space) = read_counts(&mut lines, limits)?;
 
-    match lines.next_tokens() {
-        Some((_, t)) if t == ["OFF"] => {}
-        Some((line, t)) => {
-            return Err(syntax_error(
-                line,
-                format!("expected \"OFF\", found \"{}\"", t.join(" ")),
+    let mut mesh = GradientMesh::new(colour_space);
+    mesh.points.reserve(nv.min(RESERVE_CAP));
+    mesh.faces.reserve(nf.min(RESERVE_CAP));
+    // Handles with the line they came from, checked against the faces at the end.
+    let mut handle_lines: Vec<(u32, u32, usize)> = Vec::new();
+    for v in 0..nv {
+        let (line, t) = lines.next_tokens().ok_or_else(|| {
+            lines.eof(format!(
+                "the line of vertex {v} (the header declares {nv} vertices)"
             ))
-        }
-        None => return Err(eof(&lines, "\"OFF\"".into())),
+        })?;
+        read_vertex(&t, v, nv, line, &mut mesh, &mut handle_lines)?;
     }
+    let edges = read_faces(&mut lines, nv, nf, limits, &mut mesh)?;
 
+    if let Some((line, t)) = lines.next_tokens() {
+        return Err(syntax_error(
+            line,
+            format!(
+                "expected the end of the file after {nf} faces, found \"{}\"",
+                t.join(" ")
+            ),
+        ));
+    }
+    for (v, j, line) in handle_lines {
+        if !edges.contains(&edge_key(v, j)) {
+            return Err(error_at(
+                line,
+                ErrorKind::NoSuchEdge {
+                    what: format!("the handle of vertex {v} towards its neighbour {j}"),
+                    a: v,
+                    b: j,
+                },
+            ));
+        }
+    }
+    Ok(mesh)
+}
+
+/// The first line: `OFF`.
+fn read_off_line(lines: &mut Lines) -> Result<(), Error> {
+    match lines.next_tokens() {
+        Some((_, t)) if t == ["OFF"] => Ok(()),
+        Some((line, t)) => Err(syntax_error(
+            line,
+            format!("expected \"OFF\", found \"{}\"", t.join(" ")),
+        )),
+        None => Err(lines.eof("\"OFF\"".into())),
+    }
+}
+
+/// The counts line `nV nF colour_mode`: the numbers of vertices and faces, within `limits`,
+/// and the colour space.
+fn read_counts(lines: &mut Lines, limits: &Limits) -> Result<(usize, usize, ColourSpace), Error> {
     let (line, t) = lines
         .next_tokens()
-        .ok_or_else(|| eof(&lines, "the counts \"nV nF colour_mode\"".into()))?;
+        .ok_or_else(|| lines.eof("the counts \"nV nF colour_mode\"".into()))?;
     if t.len() != 3 {
         return Err(syntax_error(
             line,
@@ -151,121 +198,143 @@ pub fn read_off_with(text: &str, limits: &Limits) -> Result<GradientMesh, Error>
             ))
         }
     };
-    let (nv, nf) = (nv as usize, nf as usize);
+    Ok((nv as usize, nf as usize, colour_space))
+}
 
-    let mut mesh = GradientMesh::new(colour_space);
-    mesh.points.reserve(nv.min(RESERVE_CAP));
-    mesh.faces.reserve(nf.min(RESERVE_CAP));
-    // Handles with the line they came from, checked against the faces at the end.
-    let mut handle_lines: Vec<(u32, u32, usize)> = Vec::new();
-
-    for v in 0..nv {
-        let (line, t) = lines.next_tokens().ok_or_else(|| {
-            eof(
-                &lines,
-                format!("the line of vertex {v} (the header declares {nv} vertices)"),
-            )
-        })?;
-        let what = |field: &str| format!("vertex {v}: {field}");
-        if t.len() < 7 {
-            return Err(syntax_error(
-                line,
-                format!(
-                    "vertex {v}: expected at least 7 values \"x y z c1 c2 c3 n\", found {}",
-                    t.len()
-                ),
-            ));
-        }
-        let x = parse_num(t[0], || what("x"), line)?;
-        let y = parse_num(t[1], || what("y"), line)?;
-        parse_num(t[2], || what("z"), line)?;
-        let mut colour = [0.0; 3];
-        for (k, c) in colour.iter_mut().enumerate() {
-            *c = parse_num(
-                t[3 + k],
-                || what(&format!("colour channel {}", k + 1)),
-                line,
-            )?;
-        }
-        let n = parse_int(t[6], || what("the number of neighbours n"), line)?;
-        if n > t.len() as u64 {
-            return Err(syntax_error(
-                line,
-                format!(
-                    "vertex {v}: the number of neighbours n = {n} is more than the {} values \
-                     of the line",
-                    t.len()
-                ),
-            ));
-        }
-        // Saturating: a huge n must not wrap around to the length of the line.
-        let (short, long) = (
-            n.saturating_mul(3).saturating_add(7),
-            n.saturating_mul(4).saturating_add(8),
-        );
-        if t.len() as u64 != short && t.len() as u64 != long {
-            return Err(syntax_error(
-                line,
-                format!(
-                    "vertex {v}: with n = {n} neighbours expected {short} values (7 + 3n), or {long} \
-                     with the n + 1 unused ones, found {}",
-                    t.len()
-                ),
-            ));
-        }
-        let n = n as usize;
-        let mut seen = HashSet::with_capacity(n);
-        for k in 0..n {
-            let j = parse_int(t[7 + k], || what(&format!("neighbour {}", k + 1)), line)?;
-            if j >= nv as u64 {
-                return Err(syntax_error(
-                    line,
-                    format!(
-                        "vertex {v}: neighbour {} is {j}, but there are only {nv} vertices",
-                        k + 1
-                    ),
-                ));
-            }
-            if j == v as u64 {
-                return Err(syntax_error(
-                    line,
-                    format!("vertex {v}: neighbour {} is the vertex itself", k + 1),
-                ));
-            }
-            if !seen.insert(j) {
-                return Err(syntax_error(
-                    line,
-                    format!("vertex {v}: neighbour {j} is listed twice"),
-                ));
-            }
-            let dx = parse_num(
-                t[7 + n + 2 * k],
-                || what(&format!("handle {} dx", k + 1)),
-                line,
-            )?;
-            let dy = parse_num(
-                t[8 + n + 2 * k],
-                || what(&format!("handle {} dy", k + 1)),
-                line,
-            )?;
-            mesh.handles.insert((v as u32, j as u32), Vec2::new(dx, dy));
-            handle_lines.push((v as u32, j as u32, line));
-        }
-        for (k, token) in t[7 + 3 * n..].iter().enumerate() {
-            parse_num(token, || what(&format!("unused value {}", k + 1)), line)?;
-        }
-        mesh.points
-            .push(ControlPoint::new(Point::new(x, y), colour));
+/// The line of vertex `v` (of `nv`): `x y z c1 c2 c3 n j_1 .. j_n dx_1 dy_1 .. [u_0 .. u_n]`.
+/// Pushes the point to `mesh`, its handles to `mesh` and `handle_lines`.
+fn read_vertex(
+    t: &[&str],
+    v: usize,
+    nv: usize,
+    line: usize,
+    mesh: &mut GradientMesh,
+    handle_lines: &mut Vec<(u32, u32, usize)>,
+) -> Result<(), Error> {
+    let what = |field: &str| format!("vertex {v}: {field}");
+    if t.len() < 7 {
+        return Err(syntax_error(
+            line,
+            format!(
+                "vertex {v}: expected at least 7 values \"x y z c1 c2 c3 n\", found {}",
+                t.len()
+            ),
+        ));
     }
+    let x = parse_num(t[0], || what("x"), line)?;
+    let y = parse_num(t[1], || what("y"), line)?;
+    parse_num(t[2], || what("z"), line)?;
+    let mut colour = [0.0; 3];
+    for (k, c) in colour.iter_mut().enumerate() {
+        *c = parse_num(
+            t[3 + k],
+            || what(&format!("colour channel {}", k + 1)),
+            line,
+        )?;
+    }
+    let n = parse_int(t[6], || what("the number of neighbours n"), line)?;
+    if n > t.len() as u64 {
+        return Err(syntax_error(
+            line,
+            format!(
+                "vertex {v}: the number of neighbours n = {n} is more than the {} values \
+                 of the line",
+                t.len()
+            ),
+        ));
+    }
+    // Saturating: a huge n must not wrap around to the length of the line.
+    let (short, long) = (
+        n.saturating_mul(3).saturating_add(7),
+        n.saturating_mul(4).saturating_add(8),
+    );
+    if t.len() as u64 != short && t.len() as u64 != long {
+        return Err(syntax_error(
+            line,
+            format!(
+                "vertex {v}: with n = {n} neighbours expected {short} values (7 + 3n), or {long} \
+                 with the n + 1 unused ones, found {}",
+                t.len()
+            ),
+        ));
+    }
+    let n = n as usize;
+    read_handles(t, v, nv, n, line, mesh, handle_lines)?;
+    for (k, token) in t[7 + 3 * n..].iter().enumerate() {
+        parse_num(token, || what(&format!("unused value {}", k + 1)), line)?;
+    }
+    mesh.points
+        .push(ControlPoint::new(Point::new(x, y), colour));
+    Ok(())
+}
 
+/// The `n` neighbours and handles of vertex `v` (of `nv`) on its line `t`.
+fn read_handles(
+    t: &[&str],
+    v: usize,
+    nv: usize,
+    n: usize,
+    line: usize,
+    mesh: &mut GradientMesh,
+    handle_lines: &mut Vec<(u32, u32, usize)>,
+) -> Result<(), Error> {
+    let what = |field: &str| format!("vertex {v}: {field}");
+    let mut seen = HashSet::with_capacity(n);
+    for k in 0..n {
+        let j = parse_int(t[7 + k], || what(&format!("neighbour {}", k + 1)), line)?;
+        if j >= nv as u64 {
+            return Err(syntax_error(
+                line,
+                format!(
+                    "vertex {v}: neighbour {} is {j}, but there are only {nv} vertices",
+                    k + 1
+                ),
+            ));
+        }
+        if j == v as u64 {
+            return Err(syntax_error(
+                line,
+                format!("vertex {v}: neighbour {} is the vertex itself", k + 1),
+            ));
+        }
+        if !seen.insert(j) {
+            return Err(syntax_error(
+                line,
+                format!("vertex {v}: neighbour {j} is listed twice"),
+            ));
+        }
+        let dx = parse_num(
+            t[7 + n + 2 * k],
+            || what(&format!("handle {} dx", k + 1)),
+            line,
+        )?;
+        let dy = parse_num(
+            t[8 + n + 2 * k],
+            || what(&format!("handle {} dy", k + 1)),
+            line,
+        )?;
+        mesh.handles.insert((v as u32, j as u32), Vec2::new(dx, dy));
+        handle_lines.push((v as u32, j as u32, line));
+    }
+    Ok(())
+}
+
+/// The `nf` face lines `k i_1 .. i_k` over `nv` vertices, pushed to `mesh`; returns the edges
+/// of the faces.
+fn read_faces(
+    lines: &mut Lines,
+    nv: usize,
+    nf: usize,
+    limits: &Limits,
+    mesh: &mut GradientMesh,
+) -> Result<HashSet<(u32, u32)>, Error> {
     let mut edges = HashSet::new();
     let mut corner_count = 0u64;
     for f in 0..nf {
         let (line, t) = lines.next_tokens().ok_or_else(|| {
-            eof(
-                &lines,
-                format!("the line of face {f} (the header declares {nf} faces)"),
-            )
+            lines.eof(format!(
+                "the line of face {f} (the header declares {nf} faces)"
+            ))
         })?;
         let k = parse_int(t[0], || format!("face {f}: the number of corners"), line)?;
         if k < 3 {
@@ -286,61 +355,45 @@ pub fn read_off_with(text: &str, limits: &Limits) -> Result<GradientMesh, Error>
                 ),
             ));
         }
-        let mut corners = Vec::with_capacity(t.len() - 1);
-        // A set, not a search of the corners so far: faces may have millions of corners.
-        let mut seen_corners = HashSet::with_capacity(t.len() - 1);
-        for (c, token) in t[1..].iter().enumerate() {
-            let i = parse_int(token, || format!("face {f}: corner {c}"), line)?;
-            if i >= nv as u64 {
-                return Err(error_at(
-                    line,
-                    ErrorKind::IndexOutOfRange {
-                        face: f,
-                        corner: c,
-                        index: i,
-                        count: nv,
-                    },
-                ));
-            }
-            if !seen_corners.insert(i) {
-                return Err(error_at(
-                    line,
-                    ErrorKind::DegenerateFace {
-                        face: f,
-                        reason: format!("vertex {i} appears twice"),
-                    },
-                ));
-            }
-            corners.push(i as u32);
-        }
+        let corners = face_corners(&t[1..], f, nv, line)?;
         for c in 0..corners.len() {
             edges.insert(edge_key(corners[c], corners[(c + 1) % corners.len()]));
         }
         mesh.faces.push(corners);
     }
+    Ok(edges)
+}
 
-    if let Some((line, t)) = lines.next_tokens() {
-        return Err(syntax_error(
-            line,
-            format!(
-                "expected the end of the file after {nf} faces, found \"{}\"",
-                t.join(" ")
-            ),
-        ));
-    }
-    for (v, j, line) in handle_lines {
-        if !edges.contains(&edge_key(v, j)) {
+/// The corners of face `f` over `nv` vertices, from their tokens.
+fn face_corners(tokens: &[&str], f: usize, nv: usize, line: usize) -> Result<Vec<u32>, Error> {
+    let mut corners = Vec::with_capacity(tokens.len());
+    // A set, not a search of the corners so far: faces may have millions of corners.
+    let mut seen_corners = HashSet::with_capacity(tokens.len());
+    for (c, token) in tokens.iter().enumerate() {
+        let i = parse_int(token, || format!("face {f}: corner {c}"), line)?;
+        if i >= nv as u64 {
             return Err(error_at(
                 line,
-                ErrorKind::NoSuchEdge {
-                    what: format!("the handle of vertex {v} towards its neighbour {j}"),
-                    a: v,
-                    b: j,
+                ErrorKind::IndexOutOfRange {
+                    face: f,
+                    corner: c,
+                    index: i,
+                    count: nv,
                 },
             ));
         }
+        if !seen_corners.insert(i) {
+            return Err(error_at(
+                line,
+                ErrorKind::DegenerateFace {
+                    face: f,
+                    reason: format!("vertex {i} appears twice"),
+                },
+            ));
+        }
+        corners.push(i as u32);
     }
-    Ok(mesh)
+    Ok(corners)
 }
 
 fn located(mut e: Error, line: usize) -> Error {
