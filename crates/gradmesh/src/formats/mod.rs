@@ -78,8 +78,8 @@ pub fn read_str_with_limits(
 ) -> Result<Document, Error> {
     match format {
         Format::Json => json::read_document_with_limits(text, limits),
-        Format::Off => off::read_off_with(text, limits).map(single_layer),
-        Format::Obj => obj::read_obj_with(text, limits).map(single_layer),
+        Format::Off => off::read_off_with_limits(text, limits).map(single_layer),
+        Format::Obj => obj::read_obj_with_limits(text, limits).map(single_layer),
     }
 }
 

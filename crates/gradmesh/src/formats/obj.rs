@@ -148,12 +148,12 @@ fn tag_sharpness(tag: &Tag, items: usize, k: usize, line: usize) -> Result<f64, 
 /// reader does not know, and tags it cannot honour (`hole`, smooth triangles), are errors rather
 /// than silently dropped.
 pub fn read_obj(text: &str) -> Result<GradientMesh, Error> {
-    read_obj_with(text, &Limits::DEFAULT)
+    read_obj_with_limits(text, &Limits::DEFAULT)
 }
 
 /// Reads an OBJ polygon mesh as [`read_obj`] does, within `limits`: input bytes, vertices, faces
 /// and corners, each refused at the line that goes beyond it.
-pub fn read_obj_with(text: &str, limits: &Limits) -> Result<GradientMesh, Error> {
+pub fn read_obj_with_limits(text: &str, limits: &Limits) -> Result<GradientMesh, Error> {
     check_size(text.len() as u64, limits.input_bytes)?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut reader = ObjReader::new(limits);

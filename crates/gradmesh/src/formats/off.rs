@@ -105,12 +105,12 @@ fn parse_num(token: &str, what: impl Fn() -> String, line: usize) -> Result<f64,
 /// handle towards a vertex that shares no face edge with its vertex is an error naming the
 /// vertex's line.
 pub fn read_off(text: &str) -> Result<GradientMesh, Error> {
-    read_off_with(text, &Limits::DEFAULT)
+    read_off_with_limits(text, &Limits::DEFAULT)
 }
 
 /// Reads the authors' extended OFF as [`read_off`] does, within `limits`: input bytes, declared
 /// vertex and face counts (refused on the counts line), and corners summed over the faces.
-pub fn read_off_with(text: &str, limits: &Limits) -> Result<GradientMesh, Error> {
+pub fn read_off_with_limits(text: &str, limits: &Limits) -> Result<GradientMesh, Error> {
     check_size(text.len() as u64, limits.input_bytes)?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut lines = Lines::new(text);

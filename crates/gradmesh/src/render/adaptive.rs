@@ -357,7 +357,7 @@ pub(super) fn tessellate(
 /// when semi-sharpness still touches the outline at [`DEEPEST_BASE_LEVEL`].
 fn build_base_level(
     refinement: &mut Refinement,
-    data: &mut RefinedMesh,
+    data: &mut RefinedData,
     xf: &ToPixels,
     size: (i64, i64),
 ) -> Option<usize> {
@@ -379,7 +379,7 @@ fn build_base_level(
 }
 
 /// Refines and evaluates `data` down to level `k`.
-fn build_levels_to(refinement: &mut Refinement, data: &mut RefinedMesh, k: usize) {
+fn build_levels_to(refinement: &mut Refinement, data: &mut RefinedData, k: usize) {
     while data.levels.len() <= k {
         let j = data.levels.len() - 1;
         refinement.extend_to(j + 1);
