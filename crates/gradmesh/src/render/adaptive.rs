@@ -512,8 +512,8 @@ mod tests {
                     let xs = [x0, x0 + f64::from(width) * step / 2.0, x0 + 0.3 * step];
                     let tall = [[xs[0], 1.0], [xs[1], 2.0], [xs[2], 8.0], [xs[0], 9.0]];
                     // The same cell on its side: between two rows.
-                    let wide = tall.map(|[x, y]| [y, x]);
-                    for quad in [tall, wide] {
+                    let flat = tall.map(|[x, y]| [y, x]);
+                    for quad in [tall, flat] {
                         if !between_pixel_centres(quad) {
                             continue;
                         }

@@ -47,18 +47,18 @@ pub struct RenderCache {
     /// The options the entries were prepared with, with the drawing-only fields reset.
     pub(super) key: Option<RenderOptions>,
     /// Per layer, by position: the mesh prepared and what preparing it gave.
-    pub(super) layers: Vec<Option<(GradientMesh, layer::Prepared)>>,
+    pub(super) layers: Vec<Option<(GradientMesh, layer::LayerPreparation)>>,
     /// Per layer, by position: the plans of its regular faces at its last preparation, once
     /// it has been prepared again (edited), which a layer prepared again after an edit takes
     /// for the faces the edit left alone.
     pub(super) plans: Vec<adaptive::TessellationCache>,
     /// The last image drawn through the cache: bands that no layer draws differently are
     /// copied from it rather than drawn again.
-    pub(super) drawn: Option<Drawn>,
+    pub(super) drawn: Option<LastImage>,
 }
 
 /// An image [`render_document_into_cached`](super::render_document_into_cached) drew, and the options it drew it with.
-pub(super) struct Drawn {
+pub(super) struct LastImage {
     pub(super) opts: RenderOptions,
     /// A `Vec<P>` of the [`OutputPixel`] type it was drawn in.
     pub(super) pixels: Box<dyn std::any::Any + Send + Sync>,

@@ -10,7 +10,7 @@ use super::coverage;
 use super::each4;
 use super::gamut::GamutMapping;
 use super::gamut::{self, BlendSpace, RUN};
-use super::layer::{PreparedLayer, BAND};
+use super::layer::{DrawableLayer, BAND};
 use super::options::RenderOptions;
 use super::output;
 use super::output::OutputPixel;
@@ -100,7 +100,7 @@ pub(super) struct Band<'a, P> {
     pub(super) index: usize,
     pub(super) columns: Range<usize>,
     pub(super) out: &'a mut [P],
-    pub(super) layers: &'a [&'a PreparedLayer],
+    pub(super) layers: &'a [&'a DrawableLayer],
     pub(super) opts: &'a RenderOptions,
     pub(super) background: Option<[f32; 4]>,
     /// Receives, per layer, the farthest an outline pixel's colour was taken from.

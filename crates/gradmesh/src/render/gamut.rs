@@ -212,7 +212,7 @@ fn to_blend_space_f32_converted(
             return linear_to_blend_space_f32(encode_table_f32(), lin, blend);
         }
     }
-    to_blend_space_wide(space, c, gamut, blend)
+    to_blend_space_in_f64(space, c, gamut, blend)
 }
 
 /// Whether every channel lies in `0..=1`.
@@ -234,14 +234,14 @@ fn linear_to_blend_space_f32(table: &[f32], lin: [f32; 3], blend: BlendSpace) ->
 }
 
 /// [`to_blend_space`] of a single-precision colour.
-fn to_blend_space_wide(
+fn to_blend_space_in_f64(
     space: ColourSpace,
     c: [f32; 3],
     gamut: GamutMapping,
     blend: BlendSpace,
 ) -> [f32; 3] {
-    let wide = to_blend_space(space, [c[0] as f64, c[1] as f64, c[2] as f64], gamut, blend);
-    [wide[0] as f32, wide[1] as f32, wide[2] as f32]
+    let double = to_blend_space(space, [c[0] as f64, c[1] as f64, c[2] as f64], gamut, blend);
+    [double[0] as f32, double[1] as f32, double[2] as f32]
 }
 
 /// Colours per run of [`RunConverter::convert`].
@@ -350,17 +350,17 @@ impl RunConverter {
         }
     }
 
-    /// [`to_blend_space_wide`] of the Lab colours `c[..][m]` for each `m` in `indices`, into
+    /// [`to_blend_space_in_f64`] of the Lab colours `c[..][m]` for each `m` in `indices`, into
     /// `out[m]`: in double precision, and gamut-mapped many colours at a time.
     #[inline(always)]
     fn convert_outside(&self, c: &[[f32; RUN]; 3], indices: &[u8], out: &mut [[f32; 3]; RUN]) {
-        // Wide groups where there are many colours (sixteen lanes overlap the search's chains
-        // of divisions better than eight or four), narrow ones for the few left.
-        let mut wide = indices.chunks_exact(GAMUT_LANES);
-        for group in &mut wide {
+        // Groups of `GAMUT_LANES` where there are many colours (sixteen lanes overlap the
+        // search's chains of divisions better than eight or four), of four for the few left.
+        let mut full = indices.chunks_exact(GAMUT_LANES);
+        for group in &mut full {
             self.convert_outside_group::<GAMUT_LANES>(c, group, out);
         }
-        for group in wide.remainder().chunks(4) {
+        for group in full.remainder().chunks(4) {
             self.convert_outside_group::<4>(c, group, out);
         }
     }
@@ -381,15 +381,15 @@ impl RunConverter {
         }
         let mapped = self.gamut.apply_lanes(lin);
         for (&m, rgb) in indices.iter().zip(mapped) {
-            out[usize::from(m)] = linear_to_blend_space_wide(rgb, self.blend);
+            out[usize::from(m)] = linear_to_blend_space_in_f64(rgb, self.blend);
         }
     }
 }
 
 /// A gamut-mapped linear-light colour in the blend space, in single precision: the end of
-/// [`to_blend_space_wide`].
+/// [`to_blend_space_in_f64`].
 #[inline(always)]
-fn linear_to_blend_space_wide(rgb: [f64; 3], blend: BlendSpace) -> [f32; 3] {
+fn linear_to_blend_space_in_f64(rgb: [f64; 3], blend: BlendSpace) -> [f32; 3] {
     let encoded = match blend {
         BlendSpace::Linear => rgb,
         BlendSpace::Srgb => rgb.map(srgb_encode_fast),
@@ -415,7 +415,7 @@ pub(crate) fn to_blend_space_f32_or_outside(
     converted_or_outside(space, c, blend)
 }
 
-/// [`to_blend_space_wide`] of a colour of `space` (not Lab) under the chroma search, stopping
+/// [`to_blend_space_in_f64`] of a colour of `space` (not Lab) under the chroma search, stopping
 /// before the search: the colour in the blend space if it lies inside the gamut, else its
 /// linear-light colour.
 #[inline(never)]
@@ -426,7 +426,7 @@ fn converted_or_outside(
 ) -> Result<[f32; 3], [f64; 3]> {
     let lin = space.to_linear_srgb(c.map(f64::from));
     if in_gamut(lin, 0.0) {
-        Ok(linear_to_blend_space_wide(lin, blend))
+        Ok(linear_to_blend_space_in_f64(lin, blend))
     } else {
         Err(lin)
     }
@@ -513,7 +513,7 @@ impl WaitingColours {
         for (k, rgb) in (start..end).zip(mapped) {
             put(
                 self.pixel[k],
-                linear_to_blend_space_wide(rgb, blend),
+                linear_to_blend_space_in_f64(rgb, blend),
                 self.alpha[k],
             );
         }
@@ -1056,15 +1056,16 @@ mod tests {
                 for b in (-120..=120).step_by(12) {
                     for blend in blends {
                         let c = [l as f64, a as f64, b as f64];
-                        let wide = to_blend_space(ColourSpace::Lab, c, GamutMapping::Chroma, blend);
-                        let narrow = to_blend_space_f32(
+                        let double =
+                            to_blend_space(ColourSpace::Lab, c, GamutMapping::Chroma, blend);
+                        let single = to_blend_space_f32(
                             ColourSpace::Lab,
                             c.map(|v| v as f32),
                             GamutMapping::Chroma,
                             blend,
                         );
                         for k in 0..3 {
-                            worst = worst.max((wide[k] - narrow[k] as f64).abs());
+                            worst = worst.max((double[k] - single[k] as f64).abs());
                         }
                     }
                 }

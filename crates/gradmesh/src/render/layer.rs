@@ -84,7 +84,7 @@ impl Bins {
 }
 
 /// Everything needed to draw one layer.
-pub(crate) struct PreparedLayer {
+pub(crate) struct DrawableLayer {
     pub space: ColourSpace,
     pub triangles: TriangleList,
     pub triangle_bins: Bins,
@@ -141,7 +141,7 @@ impl Columns {
     }
 }
 
-impl PreparedLayer {
+impl DrawableLayer {
     /// Widens, in `dirty` (columns per band of a `width`-pixel image), the columns where this
     /// layer may draw differently from `old`, its last preparation:
     /// - where a triangle of either lies that the other does not hold, bit for bit, at the
@@ -156,7 +156,7 @@ impl PreparedLayer {
     /// (its colour space, columns or colour bounds, or the number of boundary segments).
     pub fn mark_changed_columns(
         &self,
-        old: &PreparedLayer,
+        old: &DrawableLayer,
         reach: &[f64],
         width: usize,
         dirty: &mut [Columns],
@@ -219,7 +219,7 @@ impl PreparedLayer {
                 .take(rest)
                 .take_while(|&p| same(p))
                 .count();
-            let middle = |bin: &[u32], layer: &PreparedLayer| {
+            let middle = |bin: &[u32], layer: &DrawableLayer| {
                 bin[prefix..bin.len() - suffix]
                     .iter()
                     .map(|&i| {
@@ -256,7 +256,7 @@ fn in_space(mesh: &GradientMesh, space: ColourSpace) -> GradientMesh {
 }
 
 /// The result of choosing a level.
-struct Choice {
+struct ChosenLevel {
     level: usize,
     capped: bool,
     measured: Option<Measure>,
@@ -294,7 +294,7 @@ fn choose_level(
     xf: &ToPixels,
     opts: &RenderOptions,
     space: ColourSpace,
-) -> (Choice, Vec<VertexData>) {
+) -> (ChosenLevel, Vec<VertexData>) {
     let (quad, tol, colour_tol, min_quad) = if opts.reference {
         (
             opts.max_quad_px.min(REFERENCE_QUAD_PX),
@@ -323,7 +323,7 @@ fn choose_level(
         let k = forced_level(refinement.base(), forced);
         extend(refinement, data, k);
         let lim = limit_of(refinement, data, k);
-        let choice = Choice {
+        let choice = ChosenLevel {
             level: k,
             capped: false,
             measured: None,
@@ -348,7 +348,7 @@ fn choose_level(
     loop {
         let next_faces = refinement.topology(k).corner_count();
         if next_faces > opts.max_quads || k + 1 > opts.max_level.max(2) {
-            let choice = Choice {
+            let choice = ChosenLevel {
                 level: k,
                 capped: true,
                 measured: last,
@@ -368,7 +368,7 @@ fn choose_level(
             min_quad,
         );
         if passes(&m) {
-            let choice = Choice {
+            let choice = ChosenLevel {
                 level: k,
                 capped: false,
                 measured: Some(m),
@@ -382,7 +382,7 @@ fn choose_level(
             outline: 0.25 * m.outline,
         };
         if passes(&predicted) {
-            let choice = Choice {
+            let choice = ChosenLevel {
                 level: k + 1,
                 capped: false,
                 measured: Some(predicted),
@@ -456,7 +456,7 @@ fn uniform_triangles(
 
 /// What [`prepare`] returns: the layer's description, the layer ready to draw (`None` when
 /// nothing of it reaches the image) and the warnings of its validation.
-pub(crate) type Prepared = (LayerInfo, Option<PreparedLayer>, Vec<Warning>);
+pub(crate) type LayerPreparation = (LayerInfo, Option<DrawableLayer>, Vec<Warning>);
 
 /// Prepares layer `index` of a document for drawing, sharing local refinements through
 /// `shapes`, and taking the plans of unchanged regular faces from `memo` (which then holds
@@ -468,7 +468,7 @@ pub(crate) fn prepare(
     xf: &ToPixels,
     shapes: &ShapeCache,
     mut memo: Option<&mut adaptive::TessellationCache>,
-) -> Result<Prepared, Error> {
+) -> Result<LayerPreparation, Error> {
     if mesh.faces.is_empty() {
         return Ok((LayerInfo::default(), None, Vec::new()));
     }
@@ -635,7 +635,7 @@ pub(crate) fn prepare(
     let colours_in_unit_range = data.levels[k]
         .iter()
         .all(|d| d[2..5].iter().all(|c| (0.0..=1.0).contains(c)));
-    let layer = PreparedLayer {
+    let layer = DrawableLayer {
         space,
         triangles,
         triangle_bins,
@@ -654,7 +654,7 @@ mod tests {
     use super::*;
 
     /// A layer of nothing but boundary segments: one every 8 rows, down the image.
-    fn segments_only(bands: usize, shift: Option<usize>) -> PreparedLayer {
+    fn segments_only(bands: usize, shift: Option<usize>) -> DrawableLayer {
         let segments = (0..2 * bands)
             .map(|k| {
                 let y = 8.0 * k as f64;
@@ -668,7 +668,7 @@ mod tests {
                 }
             })
             .collect();
-        PreparedLayer {
+        DrawableLayer {
             space: ColourSpace::Lab,
             triangles: TriangleList::default(),
             triangle_bins: Bins::new(bands, &[]),
@@ -712,7 +712,7 @@ mod tests {
         far[3] = far[4];
         assert_eq!(changed(8.0), far);
         // Another count of segments: every column of every band.
-        let fewer = PreparedLayer {
+        let fewer = DrawableLayer {
             nearest: NearestSegments::new(Vec::new()),
             ..segments_only(bands, None)
         };

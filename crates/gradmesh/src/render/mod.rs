@@ -138,9 +138,9 @@ pub use output::{
 pub use overlay::draw_outlines;
 pub use view::{document_bounds, View};
 
-use cache::{Drawn, MAX_CACHED_SHAPES};
+use cache::{LastImage, MAX_CACHED_SHAPES};
 use composite::{draw_band, Band, Scratch};
-use layer::{Columns, PreparedLayer, BAND};
+use layer::{Columns, DrawableLayer, BAND};
 use patches::ShapeCache;
 use view::ToPixels;
 
@@ -243,7 +243,7 @@ fn render<P: OutputPixel>(
             (0..doc.layers.len()).map(|_| None).collect::<Vec<_>>(),
         ),
     };
-    let fresh: Vec<Option<layer::Prepared>> = doc
+    let fresh: Vec<Option<layer::LayerPreparation>> = doc
         .layers
         .par_iter()
         .zip(memos.par_iter_mut())
@@ -264,17 +264,17 @@ fn render<P: OutputPixel>(
         .collect::<Result<_, _>>()?;
     drop(memos);
     let reused: Vec<bool> = fresh.iter().map(Option::is_none).collect();
-    let kept: Vec<layer::Prepared>;
+    let kept: Vec<layer::LayerPreparation>;
     let bands = h.div_ceil(BAND);
-    // Entries per band of `Drawn::reach`.
+    // Entries per band of `LastImage::reach`.
     let nl = doc.layers.len().max(1);
     // The columns of each band to draw, and the last image drawn through the cache (taken out
     // while drawing: a drawing cut short leaves none), whose other pixels are as they would be
     // drawn.
     let mut dirty = vec![Columns::all(w); bands];
-    let mut last: Option<Drawn> = None;
-    let mut last_slot: Option<&mut Option<Drawn>> = None;
-    let prepared: Vec<&layer::Prepared> = match cache {
+    let mut last: Option<LastImage> = None;
+    let mut last_slot: Option<&mut Option<LastImage>> = None;
+    let prepared: Vec<&layer::LayerPreparation> = match cache {
         Some(cache) => {
             last = cache.drawn.take();
             if last.is_some() {
@@ -303,7 +303,7 @@ fn render<P: OutputPixel>(
                 .is_some_and(|p| p.len() == out.len());
             if !same_kind {
                 dirty.fill(Columns::all(w));
-                last = Some(Drawn {
+                last = Some(LastImage {
                     opts: opts.clone(),
                     pixels: Box::new(out.to_vec()),
                     reach: vec![f64::NEG_INFINITY; bands * nl],
@@ -326,7 +326,7 @@ fn render<P: OutputPixel>(
         }
     };
     let mut info = RenderInfo::default();
-    let mut layers: Vec<&PreparedLayer> = Vec::new();
+    let mut layers: Vec<&DrawableLayer> = Vec::new();
     // The document's index of each layer drawn (those with nothing to draw are left out).
     let mut layer_of: Vec<usize> = Vec::new();
     for ((layer_info, layer, warnings), reused) in prepared.into_iter().zip(reused) {
@@ -381,9 +381,9 @@ fn render<P: OutputPixel>(
         }
     };
     let chunks = out.par_chunks_mut(4 * w * BAND).enumerate();
-    let kept = last
-        .as_mut()
-        .and_then(|Drawn { pixels, reach, .. }| Some((pixels.downcast_mut::<Vec<P>>()?, reach)));
+    let kept = last.as_mut().and_then(|LastImage { pixels, reach, .. }| {
+        Some((pixels.downcast_mut::<Vec<P>>()?, reach))
+    });
     match kept {
         // Pixels drawn again are kept for the next render; the others are taken from the last.
         Some((pixels, reach)) => chunks

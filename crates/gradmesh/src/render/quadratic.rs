@@ -38,12 +38,12 @@ pub(super) struct Quadratic {
 impl Quadratic {
     /// The attributes at `x` (extrapolated outside), or `None` for a triangle without area.
     pub fn eval(&self, x: [f64; 2]) -> Option<[f64; 4]> {
-        Some(self.prepare()?.eval(x))
+        Some(self.evaluator()?.eval(x))
     }
 
-    /// The map from the plane to barycentric coordinates, found once for many points; `None`
-    /// for a triangle without area.
-    pub fn prepare(&self) -> Option<Prepared<'_>> {
+    /// The triangle ready to evaluate at many points: its map from the plane to barycentric
+    /// coordinates, found once; `None` for a triangle without area.
+    pub fn evaluator(&self) -> Option<QuadraticEvaluator<'_>> {
         let [a, b, c] = self.p;
         let (e1, e2) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
         let det = e1[0] * e2[1] - e1[1] * e2[0];
@@ -51,7 +51,7 @@ impl Quadratic {
         if !well_conditioned(det, scale) {
             return None;
         }
-        Some(Prepared {
+        Some(QuadraticEvaluator {
             q: self,
             l1: [e2[1] / det, -e2[0] / det],
             l2: [-e1[1] / det, e1[0] / det],
@@ -59,14 +59,14 @@ impl Quadratic {
     }
 }
 
-/// See [`Quadratic::prepare`].
-pub(super) struct Prepared<'a> {
+/// See [`Quadratic::evaluator`].
+pub(super) struct QuadraticEvaluator<'a> {
     q: &'a Quadratic,
     l1: [f64; 2],
     l2: [f64; 2],
 }
 
-impl Prepared<'_> {
+impl QuadraticEvaluator<'_> {
     pub fn eval(&self, x: [f64; 2]) -> [f64; 4] {
         let q = self.q;
         let (dx, dy) = (x[0] - q.p[0][0], x[1] - q.p[0][1]);
@@ -216,7 +216,7 @@ pub(super) fn measure_cells(
                 c: [c[t[0]], c[t[1]], c[t[2]]],
                 m,
             };
-            let Some(q) = q.prepare() else {
+            let Some(q) = q.evaluator() else {
                 return f64::INFINITY;
             };
             let v = [cell[t[0]], cell[t[1]], cell[t[2]]];

@@ -490,7 +490,7 @@ impl Triangle {
                     *span = if small && j.abs() < SMALL_ROWS {
                         Self::span_small(&edges, j, width)
                     } else {
-                        Self::span_wide(&edges, j, width)
+                        Self::span_i128(&edges, j, width)
                     };
                 }
             }
@@ -627,7 +627,7 @@ impl Triangle {
     }
 
     /// A row's span in 128-bit integers, for any snapped coordinates.
-    fn span_wide(edges: &[Edge; 3], j: i64, width: i64) -> (i64, i64) {
+    fn span_i128(edges: &[Edge; 3], j: i64, width: i64) -> (i64, i64) {
         let half = (SUBPIXEL / 2) as i128;
         let ry = j as i128 * SUBPIXEL as i128 + half;
         let (mut start, mut end) = (0i128, width as i128);
@@ -921,7 +921,7 @@ mod tests {
     }
 
     #[test]
-    fn narrow_and_wide_spans_agree() {
+    fn small_and_i128_spans_agree() {
         // Awkward vertices, both orientations, rows through and beside them.
         let mut bits = super::super::test_random(0x2545_f491);
         let mut next = || (bits() % 20_000) as f64 / 37.0 - 20.0;
@@ -935,14 +935,14 @@ mod tests {
                 let e = t.edges();
                 assert_eq!(
                     Triangle::span_small(&e, j, 600),
-                    Triangle::span_wide(&e, j, 600)
+                    Triangle::span_i128(&e, j, 600)
                 );
             }
         }
     }
 
     #[test]
-    fn spans_found_together_match_wide_integer_spans() {
+    fn spans_found_together_match_i128_spans() {
         // Triangles of every size from a pixel to far beyond the double-precision path's
         // range, near and far from the origin, with rows through, beside and far from them.
         let mut bits = super::super::test_random(0x9e37_79b9);
@@ -968,7 +968,7 @@ mod tests {
                 let want: Vec<_> = rows
                     .clone()
                     .map(|j| {
-                        let (a, b) = Triangle::span_wide(&e, j, width);
+                        let (a, b) = Triangle::span_i128(&e, j, width);
                         (j, a, b)
                     })
                     .collect();
