@@ -11,7 +11,7 @@ use std::ops::Range;
 use kurbo::{Point, Vec2};
 
 use crate::level::Level;
-use crate::topology::{Topology, INVALID, PARALLEL_MIN_CORNERS};
+use crate::topology::{EdgeList, FaceLoops, Rings, Topology, INVALID, PARALLEL_MIN_CORNERS};
 use crate::validate::{BaseMesh, VertexData};
 
 /// Index of the vertex point of base vertex `v`.
@@ -70,56 +70,137 @@ pub fn ternary_level(base: &BaseMesh) -> Level {
 /// `3 E + 3 c` joins the edge point of the outgoing edge to the face point `FP(c)`, `+ 1` the
 /// edge point of the incoming edge to `FP(c)`, `+ 2` joins `FP(c)` to the next face point.
 pub fn ternary_topology(t: &Topology) -> Topology {
-    let (nf, ne, nv, nc) = (
-        t.face_count(),
-        t.edge_count(),
-        t.vertex_count(),
-        t.corner_count(),
-    );
-    let ep = |e: u32, k: u32| nv as u32 + 2 * e + k;
-    let fp = |c: usize| (nv + 2 * ne + c) as u32;
-    let along = |e: u32, k: u32| 3 * e + k;
-    let middle = |e: u32| 3 * e + 2;
-    let out_spoke = |c: usize| (3 * ne + 3 * c) as u32;
-    let in_spoke = |c: usize| (3 * ne + 3 * c + 1) as u32;
-    let rim = |c: usize| (3 * ne + 3 * c + 2) as u32;
+    let split = TernarySplit::new(t);
+    // A level 1 of nine times the corners: concurrently where that pays, the rings (the
+    // largest part) against faces and edges (see `Topology::subdivide`).
+    let (rings, (faces, edges)) = if 9 * t.corner_count() < PARALLEL_MIN_CORNERS {
+        (split.rings(), (split.faces(), split.edges()))
+    } else {
+        rayon::join(
+            || split.rings(),
+            || rayon::join(|| split.faces(), || split.edges()),
+        )
+    };
+    Topology::assemble(split.child_vertex_count(), faces, edges, rings).debug_checked()
+}
 
-    // Per base corner, once: its face, neighbours, the ends of its two edges at its vertex,
-    // and its corner quad Q(c) and edge quad X(c). Plain array reads in the loops below.
-    let mut corner_face = vec![0u32; nc];
-    let mut next = vec![0u32; nc];
-    let mut prev = vec![0u32; nc];
-    let mut end_out = vec![0u32; nc];
-    let mut end_in = vec![0u32; nc];
-    let mut quad = vec![0u32; nc];
-    let mut side = vec![0u32; nc];
-    for f in 0..nf {
-        let (o, e) = (t.face_offsets[f] as usize, t.face_offsets[f + 1] as usize);
-        let n = e - o;
-        for c in o..e {
-            let (nx, pv) = (
-                if c + 1 == e { o } else { c + 1 },
-                if c == o { e - 1 } else { c - 1 },
-            );
-            let v = t.face_verts[c];
-            corner_face[c] = f as u32;
-            next[c] = nx as u32;
-            prev[c] = pv as u32;
-            end_out[c] = u32::from(t.edge_verts[t.face_edges[c] as usize][0] != v);
-            end_in[c] = u32::from(t.edge_verts[t.face_edges[pv] as usize][0] != v);
-            quad[c] = (f + o + 1 + c) as u32;
-            side[c] = (f + o + 1 + n + c) as u32;
+/// The ternary split of a topology (see [`ternary_topology`]): the base read once per corner,
+/// and the numbering of level 1's vertices, edges and faces. Faces, edges and rings are built
+/// independently, each array by one task in order, so the result does not depend on the
+/// thread count; most of the cost is the first touch of fresh memory, which both cores can
+/// take.
+struct TernarySplit<'a> {
+    base: &'a Topology,
+    /// Per base corner: its face, the next and previous corners of the face, which end of its
+    /// outgoing and of its incoming edge its vertex is, its corner quad Q(c) and its edge quad
+    /// X(c). Plain array reads in the loops that build level 1.
+    corner_face: Vec<u32>,
+    next: Vec<u32>,
+    prev: Vec<u32>,
+    end_out: Vec<u32>,
+    end_in: Vec<u32>,
+    quad: Vec<u32>,
+    side: Vec<u32>,
+    /// The corner at which each base edge leaves its end 0 (first face) and end 1 (second
+    /// face).
+    leaving: Vec<[u32; 2]>,
+}
+
+impl<'a> TernarySplit<'a> {
+    fn new(t: &'a Topology) -> Self {
+        let (nf, ne, nc) = (t.face_count(), t.edge_count(), t.corner_count());
+        let mut split = TernarySplit {
+            base: t,
+            corner_face: vec![0u32; nc],
+            next: vec![0u32; nc],
+            prev: vec![0u32; nc],
+            end_out: vec![0u32; nc],
+            end_in: vec![0u32; nc],
+            quad: vec![0u32; nc],
+            side: vec![0u32; nc],
+            leaving: vec![[INVALID; 2]; ne],
+        };
+        for f in 0..nf {
+            let (o, e) = (t.face_offsets[f] as usize, t.face_offsets[f + 1] as usize);
+            let n = e - o;
+            for c in o..e {
+                let (nx, pv) = (
+                    if c + 1 == e { o } else { c + 1 },
+                    if c == o { e - 1 } else { c - 1 },
+                );
+                let v = t.face_verts[c];
+                split.corner_face[c] = f as u32;
+                split.next[c] = nx as u32;
+                split.prev[c] = pv as u32;
+                split.end_out[c] = u32::from(t.edge_verts[t.face_edges[c] as usize][0] != v);
+                split.end_in[c] = u32::from(t.edge_verts[t.face_edges[pv] as usize][0] != v);
+                split.quad[c] = (f + o + 1 + c) as u32;
+                split.side[c] = (f + o + 1 + n + c) as u32;
+            }
         }
+        for c in 0..nc {
+            split.leaving[t.face_edges[c] as usize][split.end_out[c] as usize] = c as u32;
+        }
+        split
     }
-    let central = |f: usize| (f + 2 * t.face_offsets[f] as usize) as u32;
-    // Edge point of the outgoing and incoming edges at corner c, near c's vertex.
-    let ep_out = |c: usize| ep(t.face_edges[c], end_out[c]);
-    let ep_in = |c: usize| ep(t.face_edges[prev[c] as usize], end_in[c]);
 
-    // Faces, edges and rings are independent: built concurrently (each array by one task, in
-    // order, so the result does not depend on the thread count). Most of the cost is the first
-    // touch of fresh memory, which both cores can take.
-    let faces = || {
+    fn child_vertex_count(&self) -> usize {
+        let t = self.base;
+        t.vertex_count() + 2 * t.edge_count() + t.corner_count()
+    }
+
+    /// The edge point of base edge `e` near its end `k`.
+    #[inline]
+    fn ep(&self, e: u32, k: u32) -> u32 {
+        self.base.vertex_count() as u32 + 2 * e + k
+    }
+
+    /// The face point at base corner `c`.
+    #[inline]
+    fn fp(&self, c: usize) -> u32 {
+        (self.base.vertex_count() + 2 * self.base.edge_count() + c) as u32
+    }
+
+    /// The edge from corner `c`'s outgoing edge point to its face point.
+    #[inline]
+    fn out_spoke(&self, c: usize) -> u32 {
+        (3 * self.base.edge_count() + 3 * c) as u32
+    }
+
+    /// The edge from corner `c`'s incoming edge point to its face point.
+    #[inline]
+    fn in_spoke(&self, c: usize) -> u32 {
+        (3 * self.base.edge_count() + 3 * c + 1) as u32
+    }
+
+    /// The edge from corner `c`'s face point to the next corner's.
+    #[inline]
+    fn rim(&self, c: usize) -> u32 {
+        (3 * self.base.edge_count() + 3 * c + 2) as u32
+    }
+
+    /// The central face of base face `f`.
+    #[inline]
+    fn central(&self, f: usize) -> u32 {
+        (f + 2 * self.base.face_offsets[f] as usize) as u32
+    }
+
+    /// The edge point of the outgoing edge at corner `c`, near `c`'s vertex.
+    #[inline]
+    fn ep_out(&self, c: usize) -> u32 {
+        self.ep(self.base.face_edges[c], self.end_out[c])
+    }
+
+    /// The edge point of the incoming edge at corner `c`, near `c`'s vertex.
+    #[inline]
+    fn ep_in(&self, c: usize) -> u32 {
+        self.ep(self.base.face_edges[self.prev[c] as usize], self.end_in[c])
+    }
+
+    /// Per base face: the central face, the corner quads, the edge quads.
+    fn faces(&self) -> FaceLoops {
+        let t = self.base;
+        let (nf, nc) = (t.face_count(), t.corner_count());
         let face_count = nf + 2 * nc;
         let mut face_offsets = Vec::with_capacity(face_count + 1);
         let mut face_verts = Vec::with_capacity(9 * nc);
@@ -128,184 +209,208 @@ pub fn ternary_topology(t: &Topology) -> Topology {
         for f in 0..nf {
             let (o, e) = (t.face_offsets[f] as usize, t.face_offsets[f + 1] as usize);
             for c in o..e {
-                face_verts.push(fp(c));
-                face_edges.push(rim(c));
+                face_verts.push(self.fp(c));
+                face_edges.push(self.rim(c));
             }
             face_offsets.push(face_verts.len() as u32);
             for c in o..e {
-                let (eo, ei) = (t.face_edges[c], t.face_edges[prev[c] as usize]);
-                face_verts.extend_from_slice(&[t.face_verts[c], ep_out(c), fp(c), ep_in(c)]);
+                let (eo, ei) = (t.face_edges[c], t.face_edges[self.prev[c] as usize]);
+                face_verts.extend_from_slice(&[
+                    t.face_verts[c],
+                    self.ep_out(c),
+                    self.fp(c),
+                    self.ep_in(c),
+                ]);
                 face_edges.extend_from_slice(&[
-                    along(eo, end_out[c]),
-                    out_spoke(c),
-                    in_spoke(c),
-                    along(ei, end_in[c]),
+                    along(eo, self.end_out[c]),
+                    self.out_spoke(c),
+                    self.in_spoke(c),
+                    along(ei, self.end_in[c]),
                 ]);
                 face_offsets.push(face_verts.len() as u32);
             }
             for c in o..e {
-                let nx = next[c] as usize;
-                face_verts.extend_from_slice(&[ep_out(c), ep_in(nx), fp(nx), fp(c)]);
+                let nx = self.next[c] as usize;
+                face_verts.extend_from_slice(&[
+                    self.ep_out(c),
+                    self.ep_in(nx),
+                    self.fp(nx),
+                    self.fp(c),
+                ]);
                 face_edges.extend_from_slice(&[
                     middle(t.face_edges[c]),
-                    in_spoke(nx),
-                    rim(c),
-                    out_spoke(c),
+                    self.in_spoke(nx),
+                    self.rim(c),
+                    self.out_spoke(c),
                 ]);
                 face_offsets.push(face_verts.len() as u32);
             }
         }
-        (face_offsets, face_verts, face_edges)
-    };
-
-    // The corner at which each base edge leaves its end 0 (first face) and end 1 (second face).
-    let mut leaving = vec![[INVALID; 2]; ne];
-    for c in 0..nc {
-        leaving[t.face_edges[c] as usize][end_out[c] as usize] = c as u32;
+        FaceLoops {
+            face_offsets,
+            face_verts,
+            face_edges,
+        }
     }
-    let quad_of = |c: u32| quad[c as usize];
-    let side_of = |c: u32| side[c as usize];
-    let or_invalid = |c: u32, f: &dyn Fn(u32) -> u32| if c == INVALID { INVALID } else { f(c) };
 
-    let edges = || {
+    /// The three edges along each base edge, then the three edges of each base corner.
+    fn edges(&self) -> EdgeList {
+        let t = self.base;
+        let (ne, nc) = (t.edge_count(), t.corner_count());
         let mut edge_verts = Vec::with_capacity(3 * ne + 3 * nc);
         let mut edge_faces = Vec::with_capacity(3 * ne + 3 * nc);
+        let quad_of = |c: u32| self.quad[c as usize];
+        let side_of = |c: u32| self.side[c as usize];
         for e in 0..ne as u32 {
             let [a, b] = t.edge_verts[e as usize];
-            let [c0, c1] = leaving[e as usize];
-            edge_verts.push([a, ep(e, 0)]);
-            edge_faces.push([quad_of(c0), or_invalid(c1, &|c| quad_of(next[c as usize]))]);
-            edge_verts.push([ep(e, 1), b]);
-            edge_faces.push([quad_of(next[c0 as usize]), or_invalid(c1, &quad_of)]);
-            edge_verts.push([ep(e, 0), ep(e, 1)]);
-            edge_faces.push([side_of(c0), or_invalid(c1, &side_of)]);
+            let [c0, c1] = self.leaving[e as usize];
+            edge_verts.push([a, self.ep(e, 0)]);
+            edge_faces.push([
+                quad_of(c0),
+                or_invalid(c1, |c| quad_of(self.next[c as usize])),
+            ]);
+            edge_verts.push([self.ep(e, 1), b]);
+            edge_faces.push([quad_of(self.next[c0 as usize]), or_invalid(c1, quad_of)]);
+            edge_verts.push([self.ep(e, 0), self.ep(e, 1)]);
+            edge_faces.push([side_of(c0), or_invalid(c1, side_of)]);
         }
         for c in 0..nc {
-            let (nx, pv) = (next[c] as usize, prev[c] as usize);
-            edge_verts.push([ep_out(c), fp(c)]);
-            edge_faces.push([quad[c], side[c]]);
-            edge_verts.push([ep_in(c), fp(c)]);
-            edge_faces.push([side[pv], quad[c]]);
-            edge_verts.push([fp(c), fp(nx)]);
-            edge_faces.push([central(corner_face[c] as usize), side[c]]);
+            let (nx, pv) = (self.next[c] as usize, self.prev[c] as usize);
+            edge_verts.push([self.ep_out(c), self.fp(c)]);
+            edge_faces.push([self.quad[c], self.side[c]]);
+            edge_verts.push([self.ep_in(c), self.fp(c)]);
+            edge_faces.push([self.side[pv], self.quad[c]]);
+            edge_verts.push([self.fp(c), self.fp(nx)]);
+            edge_faces.push([self.central(self.corner_face[c] as usize), self.side[c]]);
         }
-        (edge_verts, edge_faces)
-    };
+        EdgeList {
+            edge_verts,
+            edge_faces,
+        }
+    }
 
-    // Every level-1 corner is in one ring; each ring has one more edge on a boundary.
-    let vertex_count = nv + 2 * ne + nc;
-    let rings = || {
-        let mut ring_offsets = Vec::with_capacity(vertex_count + 1);
-        let mut ring_faces = Vec::with_capacity(9 * nc);
-        let mut ring_corners = Vec::with_capacity(9 * nc);
-        let mut edge_ring_offsets = Vec::with_capacity(vertex_count + 1);
-        let mut ring_edges = Vec::with_capacity(9 * nc + vertex_count);
-        ring_offsets.push(0u32);
-        edge_ring_offsets.push(0u32);
+    /// The rings of the vertex points, then the edge points, then the face points. Every
+    /// level-1 corner is in one ring; each ring has one more edge on a boundary.
+    fn rings(&self) -> Rings {
+        let t = self.base;
+        let (nv, nc) = (t.vertex_count(), t.corner_count());
+        let vertex_count = self.child_vertex_count();
+        let mut rings = Rings::with_capacity(vertex_count, 9 * nc, 9 * nc + vertex_count);
         // Vertex points: the base ring, mapped onto the corner quads.
         for v in 0..nv {
             let (r0, r1) = (t.ring_offsets[v] as usize, t.ring_offsets[v + 1] as usize);
             for k in r0..r1 {
                 let f = t.ring_faces[k] as usize;
-                ring_faces.push(quad[t.face_offsets[f] as usize + t.ring_corners[k] as usize]);
-                ring_corners.push(0);
+                rings
+                    .ring_faces
+                    .push(self.quad[t.face_offsets[f] as usize + t.ring_corners[k] as usize]);
+                rings.ring_corners.push(0);
             }
             for &e in t.vertex_edges(v) {
-                ring_edges.push(along(e, u32::from(t.edge_verts[e as usize][0] != v as u32)));
+                rings
+                    .ring_edges
+                    .push(along(e, u32::from(t.edge_verts[e as usize][0] != v as u32)));
             }
-            ring_offsets.push(ring_faces.len() as u32);
-            edge_ring_offsets.push(ring_edges.len() as u32);
+            rings.close();
         }
-        let mut push_ring = |faces: &[(u32, u32)], edges: &[u32]| {
-            for &(f, c) in faces {
-                ring_faces.push(f);
-                ring_corners.push(c);
-            }
-            ring_edges.extend_from_slice(edges);
-            ring_offsets.push(ring_faces.len() as u32);
-            edge_ring_offsets.push(ring_edges.len() as u32);
-        };
-        // Edge points, near end 0 then near end 1 of each base edge.
-        for e in 0..ne as u32 {
-            let [c0, c1] = leaving[e as usize].map(|c| c as usize);
-            let next0 = next[c0] as usize;
-            if leaving[e as usize][1] == INVALID {
-                push_ring(
+        self.edge_point_rings(&mut rings);
+        self.face_point_rings(&mut rings);
+        rings
+    }
+
+    /// The rings of the edge points, near end 0 then near end 1 of each base edge.
+    fn edge_point_rings(&self, rings: &mut Rings) {
+        let (quad, side) = (&self.quad, &self.side);
+        for e in 0..self.base.edge_count() as u32 {
+            let [c0, c1] = self.leaving[e as usize].map(|c| c as usize);
+            let next0 = self.next[c0] as usize;
+            if self.leaving[e as usize][1] == INVALID {
+                rings.push(
                     &[(quad[c0], 1), (side[c0], 0)],
-                    &[along(e, 0), out_spoke(c0), middle(e)],
+                    &[along(e, 0), self.out_spoke(c0), middle(e)],
                 );
-                push_ring(
+                rings.push(
                     &[(side[c0], 1), (quad[next0], 3)],
-                    &[middle(e), in_spoke(next0), along(e, 1)],
+                    &[middle(e), self.in_spoke(next0), along(e, 1)],
                 );
             } else {
-                let next1 = next[c1] as usize;
-                push_ring(
+                let next1 = self.next[c1] as usize;
+                rings.push(
                     &[
                         (quad[c0], 1),
                         (side[c0], 0),
                         (side[c1], 1),
                         (quad[next1], 3),
                     ],
-                    &[along(e, 0), out_spoke(c0), middle(e), in_spoke(next1)],
+                    &[
+                        along(e, 0),
+                        self.out_spoke(c0),
+                        middle(e),
+                        self.in_spoke(next1),
+                    ],
                 );
-                push_ring(
+                rings.push(
                     &[
                         (quad[c1], 1),
                         (side[c1], 0),
                         (side[c0], 1),
                         (quad[next0], 3),
                     ],
-                    &[along(e, 1), out_spoke(c1), middle(e), in_spoke(next0)],
+                    &[
+                        along(e, 1),
+                        self.out_spoke(c1),
+                        middle(e),
+                        self.in_spoke(next0),
+                    ],
                 );
             }
         }
-        // Face points.
-        for c in 0..nc {
-            let f = corner_face[c] as usize;
-            let pv = prev[c] as usize;
-            push_ring(
+    }
+
+    /// The rings of the face points, one per base corner.
+    fn face_point_rings(&self, rings: &mut Rings) {
+        let t = self.base;
+        for c in 0..t.corner_count() {
+            let f = self.corner_face[c] as usize;
+            let pv = self.prev[c] as usize;
+            rings.push(
                 &[
-                    (quad[c], 2),
-                    (side[pv], 2),
-                    (central(f), c as u32 - t.face_offsets[f]),
-                    (side[c], 3),
+                    (self.quad[c], 2),
+                    (self.side[pv], 2),
+                    (self.central(f), c as u32 - t.face_offsets[f]),
+                    (self.side[c], 3),
                 ],
-                &[out_spoke(c), in_spoke(c), rim(pv), rim(c)],
+                &[
+                    self.out_spoke(c),
+                    self.in_spoke(c),
+                    self.rim(pv),
+                    self.rim(c),
+                ],
             );
         }
-        (
-            ring_offsets,
-            ring_faces,
-            ring_corners,
-            edge_ring_offsets,
-            ring_edges,
-        )
-    };
-    // A level 1 of nine times the corners: concurrently where that pays, the rings (the
-    // largest part) against faces and edges (see `subdivide`).
-    let (rings, ((face_offsets, face_verts, face_edges), (edge_verts, edge_faces))) =
-        if 9 * nc < PARALLEL_MIN_CORNERS {
-            (rings(), (faces(), edges()))
-        } else {
-            rayon::join(rings, || rayon::join(faces, edges))
-        };
-    let (ring_offsets, ring_faces, ring_corners, edge_ring_offsets, ring_edges) = rings;
-
-    Topology {
-        vertex_count,
-        face_offsets,
-        face_verts,
-        face_edges,
-        edge_verts,
-        edge_faces,
-        ring_offsets,
-        ring_faces,
-        ring_corners,
-        edge_ring_offsets,
-        ring_edges,
     }
-    .debug_checked()
+}
+
+/// The level-1 edge along base edge `e` at its end `k`.
+#[inline]
+fn along(e: u32, k: u32) -> u32 {
+    3 * e + k
+}
+
+/// The level-1 edge joining the two edge points of base edge `e`.
+#[inline]
+fn middle(e: u32) -> u32 {
+    3 * e + 2
+}
+
+/// `f(c)`, or `INVALID` for a missing corner `c`.
+#[inline]
+fn or_invalid(c: u32, f: impl Fn(u32) -> u32) -> u32 {
+    if c == INVALID {
+        INVALID
+    } else {
+        f(c)
+    }
 }
 
 /// The position of the face point at corner `V0` of a face (the bilinear rule of section 4.3,

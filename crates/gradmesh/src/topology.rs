@@ -45,226 +45,42 @@ impl Topology {
         face_verts: Vec<u32>,
         is_cut: impl Fn(usize, usize) -> bool,
     ) -> Result<Topology, ErrorKind> {
-        let face_count = face_offsets.len().saturating_sub(1);
-        // The last face (plus one) in which each vertex was seen: finds a repeated corner in
-        // linear time, and the same one as a scan of the earlier corners would.
-        let mut seen_in = vec![0u32; vertex_count];
-        for f in 0..face_count {
-            let corners = &face_verts[face_offsets[f] as usize..face_offsets[f + 1] as usize];
-            for (i, &v) in corners.iter().enumerate() {
-                if v as usize >= vertex_count {
-                    return Err(ErrorKind::IndexOutOfRange {
-                        face: f,
-                        corner: i,
-                        index: v as u64,
-                        count: vertex_count,
-                    });
-                }
-            }
-            if corners.len() < 3 {
-                return Err(ErrorKind::DegenerateFace {
-                    face: f,
-                    reason: format!("has {} corners, at least 3 are needed", corners.len()),
-                });
-            }
-            for &v in corners {
-                if seen_in[v as usize] == f as u32 + 1 {
-                    return Err(ErrorKind::DegenerateFace {
-                        face: f,
-                        reason: format!("visits point {v} twice"),
-                    });
-                }
-                seen_in[v as usize] = f as u32 + 1;
-            }
-        }
-
-        // Half-edge h is corner h of the flat corner list, running to the next corner.
-        let corner_count = face_verts.len();
-        let mut corner_face = vec![0u32; corner_count];
-        let mut next_corner = vec![0u32; corner_count];
-        let mut prev_corner = vec![0u32; corner_count];
-        for f in 0..face_count {
-            let (s, e) = (face_offsets[f], face_offsets[f + 1]);
-            for h in s..e {
-                corner_face[h as usize] = f as u32;
-                next_corner[h as usize] = if h + 1 == e { s } else { h + 1 };
-                prev_corner[h as usize] = if h == s { e - 1 } else { h - 1 };
-            }
-        }
-        // The vertex each half-edge runs to, read once (the keys below are taken many times).
-        let heads: Vec<u32> = next_corner
-            .iter()
-            .map(|&n| face_verts[n as usize])
-            .collect();
-        let head = |h: usize| heads[h];
-        let key = |h: u32| {
-            let (a, b) = (face_verts[h as usize], heads[h as usize]);
-            (a.min(b), a.max(b))
-        };
-        // Group half-edges by their undirected key: bucket by the smaller vertex (linear
-        // time), then sort each small bucket by the larger one.
-        let mut bucket_start = vec![0u32; vertex_count + 1];
-        for h in 0..corner_count as u32 {
-            bucket_start[key(h).0 as usize + 1] += 1;
-        }
-        for v in 0..vertex_count {
-            bucket_start[v + 1] += bucket_start[v];
-        }
-        let mut fill = bucket_start.clone();
-        let mut order = vec![0u32; corner_count];
-        for h in 0..corner_count as u32 {
-            let b = &mut fill[key(h).0 as usize];
-            order[*b as usize] = h;
-            *b += 1;
-        }
-        for v in 0..vertex_count {
-            order[bucket_start[v] as usize..bucket_start[v + 1] as usize]
-                .sort_unstable_by_key(|&h| (key(h).1, h));
-        }
-
-        let mut twin = vec![INVALID; corner_count];
-        let mut face_edges = vec![INVALID; corner_count];
-        let mut edge_verts = Vec::with_capacity(corner_count / 2 + 1);
-        let mut edge_faces = Vec::with_capacity(corner_count / 2 + 1);
-        let mut i = 0;
-        while i < order.len() {
-            let k = key(order[i]);
-            let mut j = i + 1;
-            while j < order.len() && key(order[j]) == k {
-                j += 1;
-            }
-            let group = &order[i..j];
-            let cut = |h: u32| {
-                let f = corner_face[h as usize] as usize;
-                is_cut(f, (h - face_offsets[f]) as usize)
-            };
-            let mut push_edge = |hs: &[u32]| {
-                let e = edge_verts.len() as u32;
-                let h0 = hs[0] as usize;
-                edge_verts.push([face_verts[h0], head(h0)]);
-                let f1 = hs.get(1).map_or(INVALID, |&h| corner_face[h as usize]);
-                edge_faces.push([corner_face[h0], f1]);
-                for &h in hs {
-                    face_edges[h as usize] = e;
-                }
-                if let [a, b] = hs {
-                    twin[*a as usize] = *b;
-                    twin[*b as usize] = *a;
-                }
-            };
-            if group.iter().any(|&h| cut(h)) {
-                for &h in group {
-                    push_edge(&[h]);
-                }
-            } else if group.len() == 1 {
-                push_edge(group);
-            } else if group.len() == 2 {
-                let (h0, h1) = (group[0] as usize, group[1] as usize);
-                if face_verts[h0] == face_verts[h1] {
-                    return Err(ErrorKind::InconsistentWinding {
-                        face_a: corner_face[h0] as usize,
-                        face_b: corner_face[h1] as usize,
-                        a: face_verts[h0],
-                        b: head(h0),
-                    });
-                }
-                push_edge(group);
-            } else {
-                let mut faces: Vec<usize> = group
-                    .iter()
-                    .map(|&h| corner_face[h as usize] as usize)
-                    .collect();
-                faces.sort_unstable();
-                return Err(ErrorKind::NonManifoldEdge {
-                    a: k.0,
-                    b: k.1,
-                    faces,
-                });
-            }
-            i = j;
-        }
-
-        // Corners of each vertex, then walk each vertex's fan.
-        let mut vert_corner_offsets = vec![0u32; vertex_count + 1];
-        for &v in &face_verts {
-            vert_corner_offsets[v as usize + 1] += 1;
-        }
-        for v in 0..vertex_count {
-            vert_corner_offsets[v + 1] += vert_corner_offsets[v];
-        }
-        let mut fill = vert_corner_offsets.clone();
-        let mut vert_corners = vec![0u32; corner_count];
-        for (h, &v) in face_verts.iter().enumerate() {
-            vert_corners[fill[v as usize] as usize] = h as u32;
-            fill[v as usize] += 1;
-        }
-
-        let mut ring_offsets = Vec::with_capacity(vertex_count + 1);
-        let mut ring_faces = Vec::with_capacity(corner_count);
-        let mut ring_corners = Vec::with_capacity(corner_count);
-        let mut edge_ring_offsets = Vec::with_capacity(vertex_count + 1);
-        let mut ring_edges = Vec::with_capacity(corner_count + vertex_count);
-        ring_offsets.push(0);
-        edge_ring_offsets.push(0);
-        for v in 0..vertex_count {
-            let corners =
-                &vert_corners[vert_corner_offsets[v] as usize..vert_corner_offsets[v + 1] as usize];
-            if let Some(&c0) = corners.first() {
-                // Walk backwards to the start of the fan: the corner whose incoming half-edge
-                // has no twin, or all the way round.
-                let mut start = c0;
-                loop {
-                    let t = twin[prev_corner[start as usize] as usize];
-                    if t == INVALID || t == c0 {
-                        break;
-                    }
-                    start = t;
-                }
-                let mut c = start;
-                let mut count = 0;
-                ring_edges.push(face_edges[prev_corner[c as usize] as usize]);
-                loop {
-                    let f = corner_face[c as usize];
-                    ring_faces.push(f);
-                    ring_corners.push(c - face_offsets[f as usize]);
-                    count += 1;
-                    let out = face_edges[c as usize];
-                    let t = twin[c as usize];
-                    if t == INVALID {
-                        ring_edges.push(out);
-                        break;
-                    }
-                    let next = next_corner[t as usize];
-                    if next == start {
-                        break;
-                    }
-                    ring_edges.push(out);
-                    c = next;
-                }
-                if count != corners.len() {
-                    return Err(ErrorKind::NonManifoldVertex {
-                        point: v as u32,
-                        fans: count_fans(corners, &twin, &prev_corner, &next_corner),
-                    });
-                }
-            }
-            ring_offsets.push(ring_faces.len() as u32);
-            edge_ring_offsets.push(ring_edges.len() as u32);
-        }
-
-        Ok(Topology {
-            vertex_count,
+        check_face_loops(vertex_count, &face_offsets, &face_verts)?;
+        let corners = CornerLinks::new(&face_offsets, &face_verts);
+        let order = corners.grouped_by_edge(vertex_count);
+        let pairing = corners.pair_half_edges(&order, is_cut)?;
+        let rings = corners.walk_rings(vertex_count, &pairing)?;
+        let HalfEdgePairing {
+            face_edges, edges, ..
+        } = pairing;
+        let faces = FaceLoops {
             face_offsets,
             face_verts,
             face_edges,
-            edge_verts,
-            edge_faces,
-            ring_offsets,
-            ring_faces,
-            ring_corners,
-            edge_ring_offsets,
-            ring_edges,
-        })
+        };
+        Ok(Topology::assemble(vertex_count, faces, edges, rings))
+    }
+
+    /// A topology from its parts.
+    pub(crate) fn assemble(
+        vertex_count: usize,
+        faces: FaceLoops,
+        edges: EdgeList,
+        rings: Rings,
+    ) -> Topology {
+        Topology {
+            vertex_count,
+            face_offsets: faces.face_offsets,
+            face_verts: faces.face_verts,
+            face_edges: faces.face_edges,
+            edge_verts: edges.edge_verts,
+            edge_faces: edges.edge_faces,
+            ring_offsets: rings.ring_offsets,
+            ring_faces: rings.ring_faces,
+            ring_corners: rings.ring_corners,
+            edge_ring_offsets: rings.edge_ring_offsets,
+            ring_edges: rings.ring_edges,
+        }
     }
 
     /// Builds the topology of a list of face loops, with no cut edges.
@@ -391,185 +207,20 @@ impl Topology {
 
     /// [`Topology::subdivide`], its parts built concurrently if `parallel`.
     fn subdivide_on(&self, parallel: bool) -> Topology {
-        let (nf, ne, nv, nc) = (
-            self.face_count(),
-            self.edge_count(),
-            self.vertex_count,
-            self.corner_count(),
-        );
-        let fp = |f: usize| f as u32;
-        let ep = |e: u32| (nf + e as usize) as u32;
-        let vp = |v: u32| (nf + ne + v as usize) as u32;
-        let half = |e: u32, k: usize| 2 * e + k as u32;
-        let inner = |c: usize| (2 * ne + c) as u32;
-        let end_at = |e: u32, v: u32| usize::from(self.edge_verts[e as usize][0] != v);
-
-        let mut corner_face = vec![0u32; nc];
-        for f in 0..nf {
-            corner_face[self.face_offsets[f] as usize..self.face_offsets[f + 1] as usize]
-                .fill(f as u32);
-        }
-        let next = |c: usize| {
-            let f = corner_face[c] as usize;
-            if c + 1 == self.face_offsets[f + 1] as usize {
-                self.face_offsets[f] as usize
-            } else {
-                c + 1
-            }
-        };
-        let prev = |c: usize| {
-            let f = corner_face[c] as usize;
-            if c == self.face_offsets[f] as usize {
-                self.face_offsets[f + 1] as usize - 1
-            } else {
-                c - 1
-            }
-        };
-        // The corner at which each edge leaves its end 0 (in its first face) and its end 1
-        // (in its second face).
-        let mut leaving = vec![[INVALID; 2]; ne];
-        for c in 0..nc {
-            let e = self.face_edges[c] as usize;
-            let side = usize::from(self.face_verts[c] != self.edge_verts[e][0]);
-            leaving[e][side] = c as u32;
-        }
-
-        // Faces, edges and rings are independent: built concurrently, each array by one task in
-        // order (the same result whatever the thread count); much of the cost is the first
-        // touch of fresh memory, which both cores can take.
-        let faces = || {
-            let mut face_offsets = Vec::with_capacity(nc + 1);
-            let mut face_verts = Vec::with_capacity(4 * nc);
-            let mut face_edges = Vec::with_capacity(4 * nc);
-            for c in 0..nc {
-                face_offsets.push(4 * c as u32);
-                let (v, f) = (self.face_verts[c], corner_face[c] as usize);
-                let (out, inc) = (self.face_edges[c], self.face_edges[prev(c)]);
-                face_verts.extend_from_slice(&[vp(v), ep(out), fp(f), ep(inc)]);
-                face_edges.extend_from_slice(&[
-                    half(out, end_at(out, v)),
-                    inner(c),
-                    inner(prev(c)),
-                    half(inc, end_at(inc, v)),
-                ]);
-            }
-            face_offsets.push(4 * nc as u32);
-            (face_offsets, face_verts, face_edges)
-        };
-
-        let child_face = |c: u32| if c == INVALID { INVALID } else { c };
-        let edges = || {
-            let mut edge_verts = Vec::with_capacity(2 * ne + nc);
-            let mut edge_faces = Vec::with_capacity(2 * ne + nc);
-            for e in 0..ne {
-                let [a, b] = self.edge_verts[e];
-                let [c0, c1] = leaving[e];
-                let after = |c: u32| {
-                    if c == INVALID {
-                        INVALID
-                    } else {
-                        next(c as usize) as u32
-                    }
-                };
-                edge_verts.push([vp(a), ep(e as u32)]);
-                edge_faces.push([child_face(c0), after(c1)]);
-                edge_verts.push([ep(e as u32), vp(b)]);
-                edge_faces.push([after(c0), child_face(c1)]);
-            }
-            for c in 0..nc {
-                edge_verts.push([ep(self.face_edges[c]), fp(corner_face[c] as usize)]);
-                edge_faces.push([c as u32, next(c) as u32]);
-            }
-            (edge_verts, edge_faces)
-        };
-
-        let child_vertices = nf + ne + nv;
-        let rings = || {
-            let mut ring_offsets = Vec::with_capacity(child_vertices + 1);
-            let mut ring_faces = Vec::with_capacity(4 * nc);
-            let mut ring_corners = Vec::with_capacity(4 * nc);
-            let mut edge_ring_offsets = Vec::with_capacity(child_vertices + 1);
-            let mut ring_edges = Vec::with_capacity(4 * nc + nv);
-            ring_offsets.push(0);
-            edge_ring_offsets.push(0);
-            let mut close = |ring_faces: &Vec<u32>, ring_edges: &Vec<u32>| {
-                ring_offsets.push(ring_faces.len() as u32);
-                edge_ring_offsets.push(ring_edges.len() as u32);
-            };
-            // Face points: round the face backwards.
-            for f in 0..nf {
-                let (o, n) = (self.face_offsets[f] as usize, self.face_vertices(f).len());
-                for k in 0..n {
-                    let c = o + (n - k) % n;
-                    ring_faces.push(c as u32);
-                    ring_corners.push(2);
-                    ring_edges.push(inner(c));
-                }
-                close(&ring_faces, &ring_edges);
-            }
-            // Edge points: two faces on each side of the edge.
-            for e in 0..ne {
-                let [c0, c1] = leaving[e];
-                let c0n = next(c0 as usize) as u32;
-                ring_faces.extend_from_slice(&[c0, c0n]);
-                ring_corners.extend_from_slice(&[1, 3]);
-                ring_edges.extend_from_slice(&[
-                    half(e as u32, 0),
-                    inner(c0 as usize),
-                    half(e as u32, 1),
-                ]);
-                if c1 != INVALID {
-                    ring_faces.extend_from_slice(&[c1, next(c1 as usize) as u32]);
-                    ring_corners.extend_from_slice(&[1, 3]);
-                    ring_edges.push(inner(c1 as usize));
-                }
-                close(&ring_faces, &ring_edges);
-            }
-            // Vertex points: the parent ring, mapped.
-            for v in 0..nv {
-                for (&f, &c) in self.vertex_faces(v).iter().zip(self.vertex_face_corners(v)) {
-                    ring_faces.push(self.face_offsets[f as usize] + c);
-                    ring_corners.push(0);
-                }
-                for &e in self.vertex_edges(v) {
-                    ring_edges.push(half(e, end_at(e, v as u32)));
-                }
-                close(&ring_faces, &ring_edges);
-            }
-            (
-                ring_offsets,
-                ring_faces,
-                ring_corners,
-                edge_ring_offsets,
-                ring_edges,
-            )
-        };
+        let split = CatmullClarkSplit::new(self);
         // Concurrently where it pays: a small mesh (a face's neighbourhood, refined locally)
         // is built in less time than handing its parts to other threads takes. The rings are
         // the largest part (about 14 words a parent corner, against 9 and 8): one thread takes
-        // them while the other builds faces and edges. Faces first left one thread with faces
-        // and rings, the other idle after the edges.
-        let (rings, ((face_offsets, face_verts, face_edges), (edge_verts, edge_faces))) =
-            if parallel {
-                rayon::join(rings, || rayon::join(faces, edges))
-            } else {
-                (rings(), (faces(), edges()))
-            };
-        let (ring_offsets, ring_faces, ring_corners, edge_ring_offsets, ring_edges) = rings;
-
-        Topology {
-            vertex_count: child_vertices,
-            face_offsets,
-            face_verts,
-            face_edges,
-            edge_verts,
-            edge_faces,
-            ring_offsets,
-            ring_faces,
-            ring_corners,
-            edge_ring_offsets,
-            ring_edges,
-        }
+        // them while the other builds faces and edges, so that neither waits idle for long.
+        let (rings, (faces, edges)) = if parallel {
+            rayon::join(
+                || split.rings(),
+                || rayon::join(|| split.faces(), || split.edges()),
+            )
+        } else {
+            (split.rings(), (split.faces(), split.edges()))
+        };
+        Topology::assemble(split.child_vertex_count(), faces, edges, rings)
     }
 
     /// Checks that this topology (built directly by a refinement step) has the connectivity
@@ -680,6 +331,587 @@ fn count_fans(corners: &[u32], twin: &[u32], prev: &[u32], next: &[u32]) -> usiz
         }
     }
     fans
+}
+
+/// The face loops of a topology, as [`Topology`] holds them.
+pub(crate) struct FaceLoops {
+    pub(crate) face_offsets: Vec<u32>,
+    pub(crate) face_verts: Vec<u32>,
+    pub(crate) face_edges: Vec<u32>,
+}
+
+/// The edges of a topology, as [`Topology`] holds them.
+pub(crate) struct EdgeList {
+    pub(crate) edge_verts: Vec<[u32; 2]>,
+    pub(crate) edge_faces: Vec<[u32; 2]>,
+}
+
+/// The ordered rings around the vertices of a topology, as [`Topology`] holds them, built one
+/// vertex after the other.
+pub(crate) struct Rings {
+    pub(crate) ring_offsets: Vec<u32>,
+    pub(crate) ring_faces: Vec<u32>,
+    pub(crate) ring_corners: Vec<u32>,
+    pub(crate) edge_ring_offsets: Vec<u32>,
+    pub(crate) ring_edges: Vec<u32>,
+}
+
+impl Rings {
+    /// Empty rings with room for `vertices` rings of `corners` faces and `edges` edges in all.
+    pub(crate) fn with_capacity(vertices: usize, corners: usize, edges: usize) -> Rings {
+        let mut rings = Rings {
+            ring_offsets: Vec::with_capacity(vertices + 1),
+            ring_faces: Vec::with_capacity(corners),
+            ring_corners: Vec::with_capacity(corners),
+            edge_ring_offsets: Vec::with_capacity(vertices + 1),
+            ring_edges: Vec::with_capacity(edges),
+        };
+        rings.ring_offsets.push(0);
+        rings.edge_ring_offsets.push(0);
+        rings
+    }
+
+    /// Ends the ring of the current vertex: the faces and edges pushed since the last call.
+    #[inline]
+    pub(crate) fn close(&mut self) {
+        self.ring_offsets.push(self.ring_faces.len() as u32);
+        self.edge_ring_offsets.push(self.ring_edges.len() as u32);
+    }
+
+    /// Pushes a whole ring: its `(face, corner)` pairs and its edges.
+    #[inline]
+    pub(crate) fn push(&mut self, faces: &[(u32, u32)], edges: &[u32]) {
+        for &(f, c) in faces {
+            self.ring_faces.push(f);
+            self.ring_corners.push(c);
+        }
+        self.ring_edges.extend_from_slice(edges);
+        self.close();
+    }
+}
+
+/// Refuses corner indices out of range, faces with fewer than three corners and faces that
+/// visit a vertex twice.
+fn check_face_loops(
+    vertex_count: usize,
+    face_offsets: &[u32],
+    face_verts: &[u32],
+) -> Result<(), ErrorKind> {
+    let face_count = face_offsets.len().saturating_sub(1);
+    // The last face (plus one) in which each vertex was seen: finds a repeated corner in
+    // linear time, and the same one as a scan of the earlier corners would.
+    let mut seen_in = vec![0u32; vertex_count];
+    for f in 0..face_count {
+        let corners = &face_verts[face_offsets[f] as usize..face_offsets[f + 1] as usize];
+        for (i, &v) in corners.iter().enumerate() {
+            if v as usize >= vertex_count {
+                return Err(ErrorKind::IndexOutOfRange {
+                    face: f,
+                    corner: i,
+                    index: v as u64,
+                    count: vertex_count,
+                });
+            }
+        }
+        if corners.len() < 3 {
+            return Err(ErrorKind::DegenerateFace {
+                face: f,
+                reason: format!("has {} corners, at least 3 are needed", corners.len()),
+            });
+        }
+        for &v in corners {
+            if seen_in[v as usize] == f as u32 + 1 {
+                return Err(ErrorKind::DegenerateFace {
+                    face: f,
+                    reason: format!("visits point {v} twice"),
+                });
+            }
+            seen_in[v as usize] = f as u32 + 1;
+        }
+    }
+    Ok(())
+}
+
+/// The flat corner list of checked face loops, linked: half-edge `h` is corner `h`, running to
+/// the next corner of its face.
+struct CornerLinks<'a> {
+    face_offsets: &'a [u32],
+    face_verts: &'a [u32],
+    corner_face: Vec<u32>,
+    next_corner: Vec<u32>,
+    prev_corner: Vec<u32>,
+    /// The vertex each half-edge runs to, read once (the keys are taken many times).
+    heads: Vec<u32>,
+}
+
+/// What pairing the half-edges found: each one's twin (`INVALID` on a boundary), the edge of
+/// each, and the edges.
+struct HalfEdgePairing {
+    twin: Vec<u32>,
+    face_edges: Vec<u32>,
+    edges: EdgeList,
+}
+
+impl HalfEdgePairing {
+    /// Makes the half-edges `hs` (one, or a pair of twins) a new edge.
+    #[inline]
+    fn push_edge(&mut self, hs: &[u32], corners: &CornerLinks) {
+        let e = self.edges.edge_verts.len() as u32;
+        let h0 = hs[0] as usize;
+        self.edges
+            .edge_verts
+            .push([corners.face_verts[h0], corners.head(h0)]);
+        let f1 = hs
+            .get(1)
+            .map_or(INVALID, |&h| corners.corner_face[h as usize]);
+        self.edges.edge_faces.push([corners.corner_face[h0], f1]);
+        for &h in hs {
+            self.face_edges[h as usize] = e;
+        }
+        if let [a, b] = hs {
+            self.twin[*a as usize] = *b;
+            self.twin[*b as usize] = *a;
+        }
+    }
+}
+
+impl<'a> CornerLinks<'a> {
+    fn new(face_offsets: &'a [u32], face_verts: &'a [u32]) -> Self {
+        let face_count = face_offsets.len().saturating_sub(1);
+        let corner_count = face_verts.len();
+        let mut corner_face = vec![0u32; corner_count];
+        let mut next_corner = vec![0u32; corner_count];
+        let mut prev_corner = vec![0u32; corner_count];
+        for f in 0..face_count {
+            let (s, e) = (face_offsets[f], face_offsets[f + 1]);
+            for h in s..e {
+                corner_face[h as usize] = f as u32;
+                next_corner[h as usize] = if h + 1 == e { s } else { h + 1 };
+                prev_corner[h as usize] = if h == s { e - 1 } else { h - 1 };
+            }
+        }
+        let heads = next_corner
+            .iter()
+            .map(|&n| face_verts[n as usize])
+            .collect();
+        CornerLinks {
+            face_offsets,
+            face_verts,
+            corner_face,
+            next_corner,
+            prev_corner,
+            heads,
+        }
+    }
+
+    /// The vertex half-edge `h` runs to.
+    #[inline]
+    fn head(&self, h: usize) -> u32 {
+        self.heads[h]
+    }
+
+    /// The undirected edge of half-edge `h`: its smaller vertex, then its larger.
+    #[inline]
+    fn key(&self, h: u32) -> (u32, u32) {
+        let (a, b) = (self.face_verts[h as usize], self.heads[h as usize]);
+        (a.min(b), a.max(b))
+    }
+
+    /// The half-edges in order of their undirected key: bucketed by the smaller vertex (linear
+    /// time), each small bucket sorted by the larger one.
+    fn grouped_by_edge(&self, vertex_count: usize) -> Vec<u32> {
+        let corner_count = self.face_verts.len();
+        let mut bucket_start = vec![0u32; vertex_count + 1];
+        for h in 0..corner_count as u32 {
+            bucket_start[self.key(h).0 as usize + 1] += 1;
+        }
+        for v in 0..vertex_count {
+            bucket_start[v + 1] += bucket_start[v];
+        }
+        let mut fill = bucket_start.clone();
+        let mut order = vec![0u32; corner_count];
+        for h in 0..corner_count as u32 {
+            let b = &mut fill[self.key(h).0 as usize];
+            order[*b as usize] = h;
+            *b += 1;
+        }
+        for v in 0..vertex_count {
+            order[bucket_start[v] as usize..bucket_start[v + 1] as usize]
+                .sort_unstable_by_key(|&h| (self.key(h).1, h));
+        }
+        order
+    }
+
+    /// Makes an edge of each group of half-edges with the same key in `order`: a pair of
+    /// opposite half-edges becomes one interior edge, a half-edge alone or one of a cut a
+    /// boundary edge. Refuses two half-edges in one direction and more than two.
+    fn pair_half_edges(
+        &self,
+        order: &[u32],
+        is_cut: impl Fn(usize, usize) -> bool,
+    ) -> Result<HalfEdgePairing, ErrorKind> {
+        let corner_count = self.face_verts.len();
+        let mut pairing = HalfEdgePairing {
+            twin: vec![INVALID; corner_count],
+            face_edges: vec![INVALID; corner_count],
+            edges: EdgeList {
+                edge_verts: Vec::with_capacity(corner_count / 2 + 1),
+                edge_faces: Vec::with_capacity(corner_count / 2 + 1),
+            },
+        };
+        let cut = |h: u32| {
+            let f = self.corner_face[h as usize] as usize;
+            is_cut(f, (h - self.face_offsets[f]) as usize)
+        };
+        let mut i = 0;
+        while i < order.len() {
+            let k = self.key(order[i]);
+            let mut j = i + 1;
+            while j < order.len() && self.key(order[j]) == k {
+                j += 1;
+            }
+            let group = &order[i..j];
+            if group.iter().any(|&h| cut(h)) {
+                for &h in group {
+                    pairing.push_edge(&[h], self);
+                }
+            } else if group.len() == 1 {
+                pairing.push_edge(group, self);
+            } else if group.len() == 2 {
+                let (h0, h1) = (group[0] as usize, group[1] as usize);
+                if self.face_verts[h0] == self.face_verts[h1] {
+                    return Err(ErrorKind::InconsistentWinding {
+                        face_a: self.corner_face[h0] as usize,
+                        face_b: self.corner_face[h1] as usize,
+                        a: self.face_verts[h0],
+                        b: self.head(h0),
+                    });
+                }
+                pairing.push_edge(group, self);
+            } else {
+                let mut faces: Vec<usize> = group
+                    .iter()
+                    .map(|&h| self.corner_face[h as usize] as usize)
+                    .collect();
+                faces.sort_unstable();
+                return Err(ErrorKind::NonManifoldEdge {
+                    a: k.0,
+                    b: k.1,
+                    faces,
+                });
+            }
+            i = j;
+        }
+        Ok(pairing)
+    }
+
+    /// The ring of each vertex, walked across twins from the start of its fan. Refuses a
+    /// vertex whose faces form more than one fan.
+    fn walk_rings(
+        &self,
+        vertex_count: usize,
+        pairing: &HalfEdgePairing,
+    ) -> Result<Rings, ErrorKind> {
+        let HalfEdgePairing {
+            twin, face_edges, ..
+        } = pairing;
+        let (face_verts, corner_count) = (self.face_verts, self.face_verts.len());
+        // The corners of each vertex, bucketed.
+        let mut vert_corner_offsets = vec![0u32; vertex_count + 1];
+        for &v in face_verts {
+            vert_corner_offsets[v as usize + 1] += 1;
+        }
+        for v in 0..vertex_count {
+            vert_corner_offsets[v + 1] += vert_corner_offsets[v];
+        }
+        let mut fill = vert_corner_offsets.clone();
+        let mut vert_corners = vec![0u32; corner_count];
+        for (h, &v) in face_verts.iter().enumerate() {
+            vert_corners[fill[v as usize] as usize] = h as u32;
+            fill[v as usize] += 1;
+        }
+
+        let mut rings =
+            Rings::with_capacity(vertex_count, corner_count, corner_count + vertex_count);
+        for v in 0..vertex_count {
+            let corners =
+                &vert_corners[vert_corner_offsets[v] as usize..vert_corner_offsets[v + 1] as usize];
+            if let Some(&c0) = corners.first() {
+                let count = self.walk_fan(c0, twin, face_edges, &mut rings);
+                if count != corners.len() {
+                    return Err(ErrorKind::NonManifoldVertex {
+                        point: v as u32,
+                        fans: count_fans(corners, twin, &self.prev_corner, &self.next_corner),
+                    });
+                }
+            }
+            rings.close();
+        }
+        Ok(rings)
+    }
+
+    /// Pushes to `rings` the fan of faces around the vertex of corner `c0`, from its start:
+    /// the corner whose incoming half-edge has no twin, or `c0` if the fan goes all the way
+    /// round. Returns the number of faces pushed.
+    #[inline]
+    fn walk_fan(&self, c0: u32, twin: &[u32], face_edges: &[u32], rings: &mut Rings) -> usize {
+        let mut start = c0;
+        loop {
+            let t = twin[self.prev_corner[start as usize] as usize];
+            if t == INVALID || t == c0 {
+                break;
+            }
+            start = t;
+        }
+        let mut c = start;
+        let mut count = 0;
+        rings
+            .ring_edges
+            .push(face_edges[self.prev_corner[c as usize] as usize]);
+        loop {
+            let f = self.corner_face[c as usize];
+            rings.ring_faces.push(f);
+            rings.ring_corners.push(c - self.face_offsets[f as usize]);
+            count += 1;
+            let out = face_edges[c as usize];
+            let t = twin[c as usize];
+            if t == INVALID {
+                rings.ring_edges.push(out);
+                break;
+            }
+            let next = self.next_corner[t as usize];
+            if next == start {
+                break;
+            }
+            rings.ring_edges.push(out);
+            c = next;
+        }
+        count
+    }
+}
+
+/// One Catmull-Clark split of a topology (see [`Topology::subdivide`]): the parent read once
+/// per corner and edge, and the numbering of the child's vertices, edges and faces. Faces,
+/// edges and rings are built independently, each array by one task in order (the same result
+/// whatever the thread count); much of the cost is the first touch of fresh memory, which
+/// both cores can take.
+struct CatmullClarkSplit<'a> {
+    parent: &'a Topology,
+    face_count: usize,
+    edge_count: usize,
+    /// The face of each parent corner.
+    corner_face: Vec<u32>,
+    /// The corner at which each edge leaves its end 0 (in its first face) and its end 1 (in
+    /// its second face).
+    leaving: Vec<[u32; 2]>,
+}
+
+impl<'a> CatmullClarkSplit<'a> {
+    fn new(parent: &'a Topology) -> Self {
+        let (nf, ne, nc) = (
+            parent.face_count(),
+            parent.edge_count(),
+            parent.corner_count(),
+        );
+        let mut corner_face = vec![0u32; nc];
+        for f in 0..nf {
+            corner_face[parent.face_offsets[f] as usize..parent.face_offsets[f + 1] as usize]
+                .fill(f as u32);
+        }
+        let mut leaving = vec![[INVALID; 2]; ne];
+        for c in 0..nc {
+            let e = parent.face_edges[c] as usize;
+            let side = usize::from(parent.face_verts[c] != parent.edge_verts[e][0]);
+            leaving[e][side] = c as u32;
+        }
+        CatmullClarkSplit {
+            parent,
+            face_count: nf,
+            edge_count: ne,
+            corner_face,
+            leaving,
+        }
+    }
+
+    fn child_vertex_count(&self) -> usize {
+        self.face_count + self.edge_count + self.parent.vertex_count
+    }
+
+    /// The face point of parent face `f`.
+    #[inline]
+    fn fp(&self, f: usize) -> u32 {
+        f as u32
+    }
+
+    /// The edge point of parent edge `e`.
+    #[inline]
+    fn ep(&self, e: u32) -> u32 {
+        (self.face_count + e as usize) as u32
+    }
+
+    /// The vertex point of parent vertex `v`.
+    #[inline]
+    fn vp(&self, v: u32) -> u32 {
+        (self.face_count + self.edge_count + v as usize) as u32
+    }
+
+    /// The child edge from the edge point of the outgoing edge at corner `c` to the face point.
+    #[inline]
+    fn inner(&self, c: usize) -> u32 {
+        (2 * self.edge_count + c) as u32
+    }
+
+    /// Which end of parent edge `e` vertex `v` is.
+    #[inline]
+    fn end_at(&self, e: u32, v: u32) -> usize {
+        usize::from(self.parent.edge_verts[e as usize][0] != v)
+    }
+
+    /// The corner after `c` in its face.
+    #[inline]
+    fn next(&self, c: usize) -> usize {
+        let f = self.corner_face[c] as usize;
+        if c + 1 == self.parent.face_offsets[f + 1] as usize {
+            self.parent.face_offsets[f] as usize
+        } else {
+            c + 1
+        }
+    }
+
+    /// The corner before `c` in its face.
+    #[inline]
+    fn prev(&self, c: usize) -> usize {
+        let f = self.corner_face[c] as usize;
+        if c == self.parent.face_offsets[f] as usize {
+            self.parent.face_offsets[f + 1] as usize - 1
+        } else {
+            c - 1
+        }
+    }
+
+    /// Child face `c`: the quad at parent corner `c`.
+    fn faces(&self) -> FaceLoops {
+        let t = self.parent;
+        let nc = t.corner_count();
+        let mut face_offsets = Vec::with_capacity(nc + 1);
+        let mut face_verts = Vec::with_capacity(4 * nc);
+        let mut face_edges = Vec::with_capacity(4 * nc);
+        for c in 0..nc {
+            face_offsets.push(4 * c as u32);
+            let (v, f) = (t.face_verts[c], self.corner_face[c] as usize);
+            let (out, inc) = (t.face_edges[c], t.face_edges[self.prev(c)]);
+            face_verts.extend_from_slice(&[self.vp(v), self.ep(out), self.fp(f), self.ep(inc)]);
+            face_edges.extend_from_slice(&[
+                half(out, self.end_at(out, v)),
+                self.inner(c),
+                self.inner(self.prev(c)),
+                half(inc, self.end_at(inc, v)),
+            ]);
+        }
+        face_offsets.push(4 * nc as u32);
+        FaceLoops {
+            face_offsets,
+            face_verts,
+            face_edges,
+        }
+    }
+
+    /// The two halves of each parent edge, then the edge from each corner's outgoing edge
+    /// point to its face point.
+    fn edges(&self) -> EdgeList {
+        let t = self.parent;
+        let (ne, nc) = (self.edge_count, t.corner_count());
+        let mut edge_verts = Vec::with_capacity(2 * ne + nc);
+        let mut edge_faces = Vec::with_capacity(2 * ne + nc);
+        let after = |c: u32| {
+            if c == INVALID {
+                INVALID
+            } else {
+                self.next(c as usize) as u32
+            }
+        };
+        for e in 0..ne {
+            let [a, b] = t.edge_verts[e];
+            // Child face `c` is the quad at parent corner `c` (INVALID stays INVALID).
+            let [c0, c1] = self.leaving[e];
+            edge_verts.push([self.vp(a), self.ep(e as u32)]);
+            edge_faces.push([c0, after(c1)]);
+            edge_verts.push([self.ep(e as u32), self.vp(b)]);
+            edge_faces.push([after(c0), c1]);
+        }
+        for c in 0..nc {
+            edge_verts.push([
+                self.ep(t.face_edges[c]),
+                self.fp(self.corner_face[c] as usize),
+            ]);
+            edge_faces.push([c as u32, self.next(c) as u32]);
+        }
+        EdgeList {
+            edge_verts,
+            edge_faces,
+        }
+    }
+
+    /// The rings of the face points, then the edge points, then the vertex points.
+    fn rings(&self) -> Rings {
+        let t = self.parent;
+        let (nf, ne, nv, nc) = (
+            self.face_count,
+            self.edge_count,
+            t.vertex_count,
+            t.corner_count(),
+        );
+        let mut rings = Rings::with_capacity(self.child_vertex_count(), 4 * nc, 4 * nc + nv);
+        // Face points: round the face backwards.
+        for f in 0..nf {
+            let (o, n) = (t.face_offsets[f] as usize, t.face_vertices(f).len());
+            for k in 0..n {
+                let c = o + (n - k) % n;
+                rings.ring_faces.push(c as u32);
+                rings.ring_corners.push(2);
+                rings.ring_edges.push(self.inner(c));
+            }
+            rings.close();
+        }
+        // Edge points: two faces on each side of the edge.
+        for e in 0..ne {
+            let [c0, c1] = self.leaving[e];
+            let c0n = self.next(c0 as usize) as u32;
+            rings.ring_faces.extend_from_slice(&[c0, c0n]);
+            rings.ring_corners.extend_from_slice(&[1, 3]);
+            rings.ring_edges.extend_from_slice(&[
+                half(e as u32, 0),
+                self.inner(c0 as usize),
+                half(e as u32, 1),
+            ]);
+            if c1 != INVALID {
+                rings
+                    .ring_faces
+                    .extend_from_slice(&[c1, self.next(c1 as usize) as u32]);
+                rings.ring_corners.extend_from_slice(&[1, 3]);
+                rings.ring_edges.push(self.inner(c1 as usize));
+            }
+            rings.close();
+        }
+        // Vertex points: the parent ring, mapped.
+        for v in 0..nv {
+            for (&f, &c) in t.vertex_faces(v).iter().zip(t.vertex_face_corners(v)) {
+                rings.ring_faces.push(t.face_offsets[f as usize] + c);
+                rings.ring_corners.push(0);
+            }
+            for &e in t.vertex_edges(v) {
+                rings.ring_edges.push(half(e, self.end_at(e, v as u32)));
+            }
+            rings.close();
+        }
+        rings
+    }
+}
+
+/// The child edge that is the half of parent edge `e` at its end `k`.
+#[inline]
+fn half(e: u32, k: usize) -> u32 {
+    2 * e + k as u32
 }
 
 #[cfg(test)]

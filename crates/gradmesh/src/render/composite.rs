@@ -108,7 +108,8 @@ pub(super) struct Band<'a, P> {
 }
 
 /// Draws every layer into a band. Inlined into the two compilations of
-/// [`draw_band_dispatched`], with the hot functions it calls.
+/// [`draw_band_dispatched`], with the hot functions it calls: each step below is
+/// `#[inline(always)]` so that it is compiled for the wide vectors too.
 #[inline(always)]
 pub(super) fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
     let Band {
@@ -123,40 +124,26 @@ pub(super) fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
     } = job;
     reach.fill(f64::NEG_INFINITY);
     let w = opts.width as usize;
-    let y0 = band * BAND;
     let rows = out.len() / (4 * w);
+    let area = BandArea {
+        width: w,
+        y0: band * BAND,
+        rows,
+        x0,
+        x1,
+        // Every pixel is computed alone (its coverage's prefix sum from the layer's left end):
+        // drawing some columns gives them the bits drawing all would.
+        whole_rows: x0 == 0 && x1 == w,
+    };
     let dither = opts.dither && P::DITHERED;
     let linear = opts.blend == BlendSpace::Linear;
-    // Every pixel is computed alone (its coverage's prefix sum from the layer's left end):
-    // drawing some columns gives them the bits drawing all would.
-    let whole_rows = x0 == 0 && x1 == w;
 
-    // Rows no layer reaches (a canvas larger than the drawing) are the background: one pixel,
-    // encoded once, unless dithering would give each of them its own noise.
-    if layers.iter().all(|l| l.line_bins.get(band).is_empty()) {
-        let rgba = straight_srgb::<P>(&background.unwrap_or([0.0; 4]), linear);
-        if !dither || rgba.iter().all(|&v| v == 0.0 || v == 1.0) {
-            let pixel = each4(|ch| P::encode(rgba[ch], 0.0));
-            for row in out.chunks_exact_mut(4 * w) {
-                for px in row[4 * x0..4 * x1].chunks_exact_mut(4) {
-                    px.copy_from_slice(&pixel);
-                }
-            }
-            return;
-        }
+    if layers.iter().all(|l| l.line_bins.get(band).is_empty())
+        && fill_with_background(out, area, background, dither, linear)
+    {
+        return;
     }
-
-    let colour = &mut s.colour[..w * rows];
-    if whole_rows {
-        // One call each (a loop per row was compiled into a slower inline fill).
-        colour.fill([0.0; 4]);
-        s.opaque[..w * rows].fill(false);
-    } else {
-        for r in 0..rows {
-            colour[r * w + x0..r * w + x1].fill([0.0; 4]);
-            s.opaque[r * w + x0..r * w + x1].fill(false);
-        }
-    }
+    clear_band(s, area);
 
     // Front to back ("under"): a pixel that is already opaque is not evaluated again, and the
     // band stops once all of its pixels are.
@@ -167,113 +154,240 @@ pub(super) fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
         if opaque == (x1 - x0) * rows {
             break;
         }
-        let tris = layer.triangle_bins.get(band);
-        let lines = layer.line_bins.get(band);
-        if lines.is_empty() {
+        let Some((made_opaque, farthest)) =
+            draw_layer::<P>(layer, band, area, opts, wide, fresh, s)
+        else {
             continue;
-        }
-        // Coverage is summed over the layer's columns `c0..c1`, and shown over `d0..d1`.
-        let (c0, c1) = layer.columns;
-        let (d0, d1) = (c0.max(x0), c1.min(x1));
-        if d0 >= d1 {
-            continue;
-        }
-        let shading = Shading {
-            space: layer.space,
-            converter: gamut::RunConverter::new(layer.space, opts.gamut, opts.blend, wide),
-            gamut: opts.gamut,
-            blend: opts.blend,
-            rarely_outside: layer.space == ColourSpace::Srgb
-                && opts.blend == BlendSpace::Srgb
-                && layer.colours_in_unit_range,
         };
-        let bounds = layer.bounds.as_ref().unwrap_or(&triangles::UNBOUNDED);
-        // Outline colours of a layer with quadratic sides are clamped as its triangles are.
-        let farthest = std::cell::Cell::new(f64::NEG_INFINITY);
-        let nearest = |p: [f64; 2]| {
-            let (a, distance) = layer.nearest.attributes_and_distance_at(p)?;
-            farthest.set(farthest.get().max(distance));
-            Some(match layer.bounds {
-                Some(b) => each4(|k| a[k].clamp(b[0][k], b[1][k])),
-                None => a,
-            })
-        };
+        opaque += made_opaque;
+        fresh = false;
+        reach[li] = farthest;
+    }
+    let colour = &mut s.colour[..w * rows];
+    if let Some(bg) = background {
+        put_background_under(colour, bg, area);
+    }
+    encode_band(out, colour, area, dither, linear);
+}
+
+/// The pixels of a band being drawn: columns `x0..x1` of `rows` rows from `y0`, in an image
+/// `width` pixels wide.
+#[derive(Clone, Copy)]
+struct BandArea {
+    width: usize,
+    y0: usize,
+    rows: usize,
+    x0: usize,
+    x1: usize,
+    /// Whether the columns are the whole rows.
+    whole_rows: bool,
+}
+
+/// Fills a band that no layer reaches (a canvas larger than the drawing) with the background:
+/// one pixel, encoded once. Returns false, drawing nothing, when dithering would give each
+/// pixel its own noise.
+#[inline(always)]
+fn fill_with_background<P: OutputPixel>(
+    out: &mut [P],
+    area: BandArea,
+    background: Option<[f32; 4]>,
+    dither: bool,
+    linear: bool,
+) -> bool {
+    let rgba = straight_srgb::<P>(&background.unwrap_or([0.0; 4]), linear);
+    if dither && !rgba.iter().all(|&v| v == 0.0 || v == 1.0) {
+        return false;
+    }
+    let pixel = each4(|ch| P::encode(rgba[ch], 0.0));
+    for row in out.chunks_exact_mut(4 * area.width) {
+        for px in row[4 * area.x0..4 * area.x1].chunks_exact_mut(4) {
+            px.copy_from_slice(&pixel);
+        }
+    }
+    true
+}
+
+/// Clears the colour and opacity of the band's pixels.
+#[inline(always)]
+fn clear_band(s: &mut Scratch, area: BandArea) {
+    let BandArea {
+        width: w,
+        rows,
+        x0,
+        x1,
+        ..
+    } = area;
+    let colour = &mut s.colour[..w * rows];
+    if area.whole_rows {
+        // One call each (a loop per row was compiled into a slower inline fill).
+        colour.fill([0.0; 4]);
+        s.opaque[..w * rows].fill(false);
+    } else {
         for r in 0..rows {
-            s.covered[r * w + d0..r * w + d1].fill(false);
+            colour[r * w + x0..r * w + x1].fill([0.0; 4]);
+            s.opaque[r * w + x0..r * w + x1].fill(false);
         }
-        let mut cursor = layer.triangles.cursor();
-        for &ti in tris {
-            let t = cursor.get(ti as usize);
-            if !whole_rows {
-                let (a, b) = t.columns(w);
-                if b <= d0 || a >= d1 {
-                    continue;
-                }
-            }
-            let (r0, r1) = t.rows();
-            let (j0, j1) = (r0.max(y0 as i64), r1.min((y0 + rows) as i64));
-            t.for_each_span(j0..j1, w as i64, |j, a, b| {
-                let (a, b) = ((a as usize).max(d0), (b as usize).min(d1));
-                if a >= b {
-                    return;
-                }
-                let row = (j as usize - y0) * w;
-                let y = j as f64 + 0.5;
-                let span = row + a..row + b;
-                t.fill_row(y, a as f64 + 0.5, &mut s.attributes[span.clone()], bounds);
-                s.covered[span].fill(true);
-            });
+    }
+}
+
+/// Composites one layer under the band's colour. Returns how many pixels became opaque and
+/// the farthest an outline pixel's colour was taken from, or `None` when the layer reaches
+/// none of the band's pixels. `P`: see [`fill_triangles`].
+#[inline(always)]
+fn draw_layer<P: OutputPixel>(
+    layer: &DrawableLayer,
+    band: usize,
+    area: BandArea,
+    opts: &RenderOptions,
+    wide: bool,
+    fresh: bool,
+    s: &mut Scratch,
+) -> Option<(usize, f64)> {
+    let BandArea {
+        width: w,
+        y0,
+        rows,
+        x0,
+        x1,
+        ..
+    } = area;
+    let lines = layer.line_bins.get(band);
+    if lines.is_empty() {
+        return None;
+    }
+    // Coverage is summed over the layer's columns `c0..c1`, and shown over `d0..d1`.
+    let (c0, c1) = layer.columns;
+    let (d0, d1) = (c0.max(x0), c1.min(x1));
+    if d0 >= d1 {
+        return None;
+    }
+    let shading = Shading::of_layer(layer, opts, wide);
+    // Outline colours of a layer with quadratic sides are clamped as its triangles are.
+    let farthest = std::cell::Cell::new(f64::NEG_INFINITY);
+    let nearest = |p: [f64; 2]| {
+        let (a, distance) = layer.nearest.attributes_and_distance_at(p)?;
+        farthest.set(farthest.get().max(distance));
+        Some(match layer.bounds {
+            Some(b) => each4(|k| a[k].clamp(b[0][k], b[1][k])),
+            None => a,
+        })
+    };
+    fill_triangles::<P>(layer, band, area, d0..d1, s);
+    for &li in lines {
+        let line = &layer.lines[li as usize];
+        // A line changes the cells from the one holding its left end: one right of the
+        // columns drawn changes no sum they take.
+        if !area.whole_rows && line.p0[0].min(line.p1[0]) >= d1 as f64 {
+            continue;
         }
-        for &li in lines {
-            let line = &layer.lines[li as usize];
-            // A line changes the cells from the one holding its left end: one right of the
-            // columns drawn changes no sum they take.
-            if !whole_rows && line.p0[0].min(line.p1[0]) >= d1 as f64 {
+        s.accumulation.add(y0 as i64, rows, line);
+    }
+    let colour = &mut s.colour[..w * rows];
+    let mut opaque = 0;
+    for r in 0..rows {
+        // Left of the layer's columns the accumulation is all zeros, so its prefix sums
+        // may start there. Only columns `a..b` are covered at all.
+        let (a, b) = s.accumulation.resolve(r, c0, d1, &mut s.coverage);
+        // Bounds the loops below can see, so that they index without checks.
+        let coverage = &s.coverage[..d1];
+        let (a, b) = (a.max(d0), b.min(d1));
+        let y = (y0 + r) as f64 + 0.5;
+        let band = BandPixels {
+            row: r * w,
+            opaque: &mut s.opaque,
+            covered: &s.covered,
+            attributes: &s.attributes,
+            run: &mut s.run,
+            colour,
+        };
+        // Separate loops for the first layer, which has nothing to test and nothing to
+        // read: the tests are a noticeable share of drawing.
+        opaque += if fresh {
+            shade_row::<true>(a..b, coverage, y, band, &nearest, &shading)
+        } else {
+            shade_row::<false>(a..b, coverage, y, band, &nearest, &shading)
+        };
+    }
+    Some((opaque, farthest.get()))
+}
+
+/// Fills the attributes of the pixels in columns `cols` that the layer's triangles cover, and
+/// marks them covered. Generic over the output pixel type `P` only so that each compilation
+/// of [`draw_band`] gets its own copy of the span closure, which is then inlined into it (a
+/// single copy called from all of them is not, and is compiled without the wide vectors).
+#[allow(clippy::extra_unused_type_parameters)]
+#[inline(always)]
+fn fill_triangles<P: OutputPixel>(
+    layer: &DrawableLayer,
+    band: usize,
+    area: BandArea,
+    cols: Range<usize>,
+    s: &mut Scratch,
+) {
+    let BandArea {
+        width: w, y0, rows, ..
+    } = area;
+    let Range { start: d0, end: d1 } = cols;
+    let bounds = layer.bounds.as_ref().unwrap_or(&triangles::UNBOUNDED);
+    for r in 0..rows {
+        s.covered[r * w + d0..r * w + d1].fill(false);
+    }
+    let mut cursor = layer.triangles.cursor();
+    for &ti in layer.triangle_bins.get(band) {
+        let t = cursor.get(ti as usize);
+        if !area.whole_rows {
+            let (a, b) = t.columns(w);
+            if b <= d0 || a >= d1 {
                 continue;
             }
-            s.accumulation.add(y0 as i64, rows, line);
         }
-        for r in 0..rows {
-            // Left of the layer's columns the accumulation is all zeros, so its prefix sums
-            // may start there. Only columns `a..b` are covered at all.
-            let (a, b) = s.accumulation.resolve(r, c0, d1, &mut s.coverage);
-            // Bounds the loops below can see, so that they index without checks.
-            let coverage = &s.coverage[..d1];
-            let (a, b) = (a.max(d0), b.min(d1));
-            let y = (y0 + r) as f64 + 0.5;
-            let band = BandPixels {
-                row: r * w,
-                opaque: &mut s.opaque,
-                covered: &s.covered,
-                attributes: &s.attributes,
-                run: &mut s.run,
-                colour,
-            };
-            // Separate loops for the first layer, which has nothing to test and nothing to
-            // read: the tests are a noticeable share of drawing.
-            opaque += if fresh {
-                shade_row::<true>(a..b, coverage, y, band, &nearest, &shading)
-            } else {
-                shade_row::<false>(a..b, coverage, y, band, &nearest, &shading)
-            };
-        }
-        fresh = false;
-        reach[li] = farthest.get();
+        let (r0, r1) = t.rows();
+        let (j0, j1) = (r0.max(y0 as i64), r1.min((y0 + rows) as i64));
+        t.for_each_span(j0..j1, w as i64, |j, a, b| {
+            let (a, b) = ((a as usize).max(d0), (b as usize).min(d1));
+            if a >= b {
+                return;
+            }
+            let row = (j as usize - y0) * w;
+            let y = j as f64 + 0.5;
+            let span = row + a..row + b;
+            t.fill_row(y, a as f64 + 0.5, &mut s.attributes[span.clone()], bounds);
+            s.covered[span].fill(true);
+        });
     }
-    if let Some(bg) = background {
-        for row in colour.chunks_exact_mut(w) {
-            for dst in &mut row[x0..x1] {
-                let keep = 1.0 - dst[3];
-                if keep > 0.0 {
-                    for c in 0..4 {
-                        dst[c] += bg[c] * keep;
-                    }
+}
+
+/// Composites the premultiplied background `bg` under the band's colour.
+#[inline(always)]
+fn put_background_under(colour: &mut [[f32; 4]], bg: [f32; 4], area: BandArea) {
+    for row in colour.chunks_exact_mut(area.width) {
+        for dst in &mut row[area.x0..area.x1] {
+            let keep = 1.0 - dst[3];
+            if keep > 0.0 {
+                for c in 0..4 {
+                    dst[c] += bg[c] * keep;
                 }
             }
         }
     }
+}
 
-    // Straight alpha, sRGB-encoded.
+/// Encodes the band's premultiplied colour into `out`: straight alpha, sRGB-encoded.
+#[inline(always)]
+fn encode_band<P: OutputPixel>(
+    out: &mut [P],
+    colour: &[[f32; 4]],
+    area: BandArea,
+    dither: bool,
+    linear: bool,
+) {
+    let BandArea {
+        width: w,
+        y0,
+        x0,
+        x1,
+        ..
+    } = area;
     for (r, (row_out, row_colour)) in out
         .chunks_exact_mut(4 * w)
         .zip(colour.chunks_exact(w))
@@ -403,6 +517,22 @@ struct Shading {
     /// Whether colours outside the gamut are rare enough to be mapped one by one, in the
     /// plain pixel loop (an sRGB layer blended in sRGB with colours in range).
     rarely_outside: bool,
+}
+
+impl Shading {
+    /// How `layer` is shaded with `opts`; `wide`: in the x86-64-v3 compilation.
+    #[inline(always)]
+    fn of_layer(layer: &DrawableLayer, opts: &RenderOptions, wide: bool) -> Shading {
+        Shading {
+            space: layer.space,
+            converter: gamut::RunConverter::new(layer.space, opts.gamut, opts.blend, wide),
+            gamut: opts.gamut,
+            blend: opts.blend,
+            rarely_outside: layer.space == ColourSpace::Srgb
+                && opts.blend == BlendSpace::Srgb
+                && layer.colours_in_unit_range,
+        }
+    }
 }
 
 /// One row of a band's buffers, as a layer shades it.

@@ -12,8 +12,7 @@ use crate::limits::Limits;
 use crate::mesh::GradientMesh;
 use crate::refine::{RefinedData, Refinement};
 use crate::topology::Topology;
-use crate::validate::BaseMesh;
-use crate::validate::VertexData;
+use crate::validate::{attributes, BaseMesh, VertexData, COLOUR, X, Y};
 
 use super::adaptive;
 use super::coverage::Line;
@@ -405,11 +404,8 @@ fn uniform_triangles(
     xf: &ToPixels,
     size: (i64, i64),
 ) -> (TriangleList, Vec<Segment>) {
-    let exact: Vec<[f64; 2]> = lim.iter().map(|d| xf.apply(d[0], d[1])).collect();
-    let attr = |v: u32| {
-        let d = &lim[v as usize];
-        [d[2], d[3], d[4], d[5]]
-    };
+    let exact: Vec<[f64; 2]> = lim.iter().map(|d| xf.apply(d[X], d[Y])).collect();
+    let attr = |v: u32| attributes(&lim[v as usize]);
     let face_triangles = |f: usize| -> Vec<Triangle> {
         let fv = t.face_vertices(f);
         (1..fv.len() - 1)
@@ -475,6 +471,83 @@ pub(crate) fn prepare(
     let mut timings = LayerTimings::default();
     let start = Instant::now();
     let space = opts.colour_space_override.unwrap_or(mesh.colour_space);
+    let (mut refinement, warnings) = refine_layer(mesh, index, opts, space, memo.as_deref_mut())?;
+    let mut data = refinement.evaluate_to(refinement.base(), 1);
+    timings.refine = start.elapsed();
+    let start = Instant::now();
+    let tess = tessellate_layer(
+        &mut refinement,
+        &mut data,
+        xf,
+        opts,
+        space,
+        shapes,
+        memo.as_deref_mut(),
+    );
+    let LayerTriangles {
+        level: k,
+        triangles,
+        segments,
+        bounds,
+        mut info,
+    } = tess;
+    info.timings = LayerTimings {
+        evaluate: start.elapsed(),
+        ..timings
+    };
+    let start = Instant::now();
+    let h = opts.height as i64;
+    let bands = (opts.height as usize).div_ceil(BAND);
+    let triangle_bins = bin_triangles(&triangles, bands, h);
+
+    // The outline, from the control points of level k.
+    let loops = boundary_loops(refinement.topology(k));
+    let control_px: Vec<[f64; 2]> = data.levels[k]
+        .iter()
+        .map(|d| xf.apply(d[X], d[Y]))
+        .collect();
+    let tolerance = if opts.reference {
+        REFERENCE_OUTLINE_TOLERANCE_PX
+    } else {
+        OUTLINE_TOLERANCE_PX
+    };
+    let all_lines = outline(refinement.level(k), &loops, &control_px, tolerance);
+    if let Some(memo) = memo {
+        memo.refinement = Some(refinement);
+    }
+    let (lines, line_bins, columns) = visible_outline(all_lines, opts, bands);
+
+    let nearest = NearestSegments::new(segments);
+    info.timings.tessellate = start.elapsed();
+    if lines.is_empty() || columns.0 >= columns.1 {
+        return Ok((info, None, warnings));
+    }
+    let colours_in_unit_range = data.levels[k]
+        .iter()
+        .all(|d| d[COLOUR].iter().all(|c| (0.0..=1.0).contains(c)));
+    let layer = DrawableLayer {
+        space,
+        triangles,
+        triangle_bins,
+        lines,
+        line_bins,
+        nearest,
+        columns,
+        bounds,
+        colours_in_unit_range,
+    };
+    Ok((info, Some(layer), warnings))
+}
+
+/// Validates layer `index` in `space` and readies its refinement at level 1, within
+/// [`RenderOptions::max_quads`]; with the validation's warnings, marked with the layer.
+fn refine_layer(
+    mesh: &GradientMesh,
+    index: usize,
+    opts: &RenderOptions,
+    space: ColourSpace,
+    memo: Option<&mut adaptive::TessellationCache>,
+) -> Result<(Refinement, Vec<Warning>), Error> {
     let original_space = mesh.colour_space;
     let mesh = in_space(mesh, space);
     // Level 1 only: the fast path of a dense layer starts there, and each path builds the
@@ -491,7 +564,7 @@ pub(crate) fn prepare(
     }
     .check_refinement(&base, deepest)
     .map_err(|e| e.in_layer(index))?;
-    let kept = memo.as_deref_mut().and_then(|m| m.refinement.take());
+    let kept = memo.and_then(|m| m.refinement.take());
     let mut refinement = Refinement::rebased_or_new(kept, base, 1);
     // The edits' colours stay in the space they were written in.
     refinement.set_edit_colour_space(original_space);
@@ -502,77 +575,99 @@ pub(crate) fn prepare(
             ..w
         })
         .collect();
-    let mut data = refinement.evaluate_to(refinement.base(), 1);
-    timings.refine = start.elapsed();
-    let start = Instant::now();
-    let (w, h) = (opts.width as i64, opts.height as i64);
-    let bands = (opts.height as usize).div_ceil(BAND);
+    Ok((refinement, warnings))
+}
 
+/// A layer's triangles: the level they were made at, the triangles, the boundary segments of
+/// the tessellation, the colour bounds of quadratic triangles, and the layer's description
+/// (without timings).
+struct LayerTriangles {
+    level: usize,
+    triangles: TriangleList,
+    segments: Vec<Segment>,
+    bounds: Option<Bounds>,
+    info: LayerInfo,
+}
+
+/// Tessellates a layer: by the fast path where it applies and succeeds (sharing local
+/// refinements through `shapes`, and taking plans from `memo`), else uniformly.
+fn tessellate_layer(
+    refinement: &mut Refinement,
+    data: &mut RefinedData,
+    xf: &ToPixels,
+    opts: &RenderOptions,
+    space: ColourSpace,
+    shapes: &ShapeCache,
+    memo: Option<&mut adaptive::TessellationCache>,
+) -> LayerTriangles {
+    let (w, h) = (opts.width as i64, opts.height as i64);
     let th = Thresholds::new(opts, space);
     // The fast path starts at its base level: a shallower cap is the uniform path's to honour.
     let fast = if opts.reference || opts.level.is_some() || opts.max_level < adaptive::BASE_LEVEL {
         None
     } else {
         adaptive::tessellate(
-            &mut refinement,
-            &mut data,
+            refinement,
+            data,
             xf,
             &th,
             opts.max_level,
             (w, h),
             adaptive::Caches {
                 shapes,
-                tessellation: memo.as_deref_mut(),
+                tessellation: memo,
             },
         )
     };
-    let (k, triangles, segments, bounds, mut info) = match fast {
-        Some(tess) => {
-            timings.evaluate = start.elapsed();
-            let info = LayerInfo {
-                level: tess.level,
-                capped: tess.capped,
-                quads: tess.quads,
-                triangles: tess.triangles.len(),
-                max_quad_px: tess.measured.extent,
-                max_outline_deviation_px: tess.measured.outline,
-                max_colour_error: tess.measured.colour,
-                estimated: tess.estimated,
-                timings,
-                reused: false,
-                reused_faces: tess.reused_plans,
-            };
-            (
-                tess.base_level,
-                tess.triangles,
-                tess.segments,
-                tess.bounds,
-                info,
-            )
-        }
-        None => {
-            let (choice, lim) = choose_level(&mut refinement, &mut data, xf, opts, space);
-            timings.evaluate = start.elapsed();
-            let (triangles, segments) =
-                uniform_triangles(refinement.topology(choice.level), &lim, xf, (w, h));
-            let info = LayerInfo {
-                level: choice.level,
-                capped: choice.capped,
-                quads: refinement.topology(choice.level).face_count(),
-                triangles: triangles.len(),
-                max_quad_px: choice.measured.map_or(f64::NAN, |m| m.extent),
-                max_outline_deviation_px: choice.measured.map_or(f64::NAN, |m| m.outline),
-                max_colour_error: choice.measured.map_or(f64::NAN, |m| m.colour),
-                estimated: choice.estimated,
-                timings,
-                reused: false,
-                reused_faces: 0,
-            };
-            (choice.level, triangles, segments, None, info)
-        }
+    if let Some(tess) = fast {
+        let info = LayerInfo {
+            level: tess.level,
+            capped: tess.capped,
+            quads: tess.quads,
+            triangles: tess.triangles.len(),
+            max_quad_px: tess.measured.extent,
+            max_outline_deviation_px: tess.measured.outline,
+            max_colour_error: tess.measured.colour,
+            estimated: tess.estimated,
+            timings: LayerTimings::default(),
+            reused: false,
+            reused_faces: tess.reused_plans,
+        };
+        return LayerTriangles {
+            level: tess.base_level,
+            triangles: tess.triangles,
+            segments: tess.segments,
+            bounds: tess.bounds,
+            info,
+        };
+    }
+    let (choice, lim) = choose_level(refinement, data, xf, opts, space);
+    let (triangles, segments) =
+        uniform_triangles(refinement.topology(choice.level), &lim, xf, (w, h));
+    let info = LayerInfo {
+        level: choice.level,
+        capped: choice.capped,
+        quads: refinement.topology(choice.level).face_count(),
+        triangles: triangles.len(),
+        max_quad_px: choice.measured.map_or(f64::NAN, |m| m.extent),
+        max_outline_deviation_px: choice.measured.map_or(f64::NAN, |m| m.outline),
+        max_colour_error: choice.measured.map_or(f64::NAN, |m| m.colour),
+        estimated: choice.estimated,
+        timings: LayerTimings::default(),
+        reused: false,
+        reused_faces: 0,
     };
-    let start = Instant::now();
-    let t = refinement.topology(k);
+    LayerTriangles {
+        level: choice.level,
+        triangles,
+        segments,
+        bounds: None,
+        info,
+    }
+}
+
+/// The triangles of each band of rows, of an image `h` rows high.
+fn bin_triangles(triangles: &TriangleList, bands: usize, h: i64) -> Bins {
     let ranges: Vec<(u32, usize, usize)> = triangles
         .iter()
         .enumerate()
@@ -581,23 +676,17 @@ pub(crate) fn prepare(
             (i as u32, a, b)
         })
         .collect();
-    let triangle_bins = Bins::new(bands, &ranges);
+    Bins::new(bands, &ranges)
+}
 
-    // The outline, from the control points of level k.
-    let loops = boundary_loops(t);
-    let control_px: Vec<[f64; 2]> = data.levels[k]
-        .iter()
-        .map(|d| xf.apply(d[0], d[1]))
-        .collect();
-    let tolerance = if opts.reference {
-        REFERENCE_OUTLINE_TOLERANCE_PX
-    } else {
-        OUTLINE_TOLERANCE_PX
-    };
-    let all_lines = outline(refinement.level(k), &loops, &control_px, tolerance);
-    if let Some(memo) = memo {
-        memo.refinement = Some(refinement);
-    }
+/// The lines of the outline that can change a pixel of the image, binned by band, and the
+/// columns where coverage can be non-zero.
+fn visible_outline(
+    all_lines: Vec<Line>,
+    opts: &RenderOptions,
+    bands: usize,
+) -> (Vec<Line>, Bins, (usize, usize)) {
+    let (w, h) = (opts.width as i64, opts.height as i64);
     let mut lines = Vec::new();
     let mut line_ranges = Vec::new();
     let (mut c0, mut c1) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -626,27 +715,7 @@ pub(crate) fn prepare(
             (c1.ceil() + 1.0).clamp(0.0, w as f64) as usize,
         )
     };
-
-    let nearest = NearestSegments::new(segments);
-    info.timings.tessellate = start.elapsed();
-    if lines.is_empty() || columns.0 >= columns.1 {
-        return Ok((info, None, warnings));
-    }
-    let colours_in_unit_range = data.levels[k]
-        .iter()
-        .all(|d| d[2..5].iter().all(|c| (0.0..=1.0).contains(c)));
-    let layer = DrawableLayer {
-        space,
-        triangles,
-        triangle_bins,
-        lines,
-        line_bins,
-        nearest,
-        columns,
-        bounds,
-        colours_in_unit_range,
-    };
-    Ok((info, Some(layer), warnings))
+    (lines, line_bins, columns)
 }
 
 #[cfg(test)]

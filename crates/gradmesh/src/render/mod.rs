@@ -195,74 +195,14 @@ fn render<P: OutputPixel>(
     out: &mut [P],
 ) -> Result<RenderInfo, Error> {
     opts.check()?;
+    check_output_buffer(opts, out.len())?;
     let (w, h) = (opts.width as usize, opts.height as usize);
-    if out.len() != 4 * w * h {
-        return Err(ErrorKind::Invalid {
-            what: "output buffer".into(),
-            message: format!(
-                "holds {} channels, a {w}x{h} RGBA image needs {}",
-                out.len(),
-                4 * w * h
-            ),
-        }
-        .into());
-    }
     let xf = ToPixels::new(&opts.view, opts.width, opts.height);
     let start = Instant::now();
     if let Some(cache) = cache.as_deref_mut() {
-        let key = RenderCache::key(opts);
-        if cache.key.as_ref() != Some(&key) {
-            cache.key = Some(key);
-            cache.layers.clear();
-            cache.plans.clear();
-        }
-        // A document with other layers, or other drawing options, draws every band again.
-        if cache.layers.len() != doc.layers.len()
-            || cache.drawn.as_ref().is_some_and(|d| d.opts != *opts)
-        {
-            cache.drawn = None;
-        }
-        cache.layers.resize_with(doc.layers.len(), || None);
-        cache.plans.resize_with(doc.layers.len(), Default::default);
-        if cache.shapes.len() > MAX_CACHED_SHAPES {
-            cache.shapes = Arc::default();
-        }
+        ready_cache(cache, doc, opts);
     }
-    let shapes: Arc<ShapeCache> = cache
-        .as_deref()
-        .map(|c| Arc::clone(&c.shapes))
-        .unwrap_or_default();
-    // The layers to prepare (`None`: taken from the cache).
-    let (cached, mut memos) = match cache.as_deref_mut() {
-        Some(c) => (
-            Some(c.layers.as_slice()),
-            c.plans.iter_mut().map(Some).collect(),
-        ),
-        None => (
-            None,
-            (0..doc.layers.len()).map(|_| None).collect::<Vec<_>>(),
-        ),
-    };
-    let fresh: Vec<Option<layer::LayerPreparation>> = doc
-        .layers
-        .par_iter()
-        .zip(memos.par_iter_mut())
-        .enumerate()
-        .map(|(i, (mesh, memo))| {
-            let entry = cached.and_then(|c| c[i].as_ref());
-            if entry.is_some_and(|(old, _)| old == mesh) {
-                return Ok(None);
-            }
-            // Plans are kept for layers prepared again (edited): keeping every layer's would
-            // cost a copy of its plans at its first preparation, and memory, for nothing.
-            let memo = memo.as_deref_mut().filter(|_| entry.is_some());
-            layer::prepare(mesh, i, opts, &xf, &shapes, memo).map(Some)
-        })
-        .collect::<Vec<_>>()
-        // The first failing layer's error, whatever the thread count.
-        .into_iter()
-        .collect::<Result<_, _>>()?;
-    drop(memos);
+    let fresh = prepare_layers(doc, opts, &xf, cache.as_deref_mut())?;
     let reused: Vec<bool> = fresh.iter().map(Option::is_none).collect();
     let kept: Vec<layer::LayerPreparation>;
     let bands = h.div_ceil(BAND);
@@ -276,46 +216,10 @@ fn render<P: OutputPixel>(
     let mut last_slot: Option<&mut Option<LastImage>> = None;
     let prepared: Vec<&layer::LayerPreparation> = match cache {
         Some(cache) => {
-            last = cache.drawn.take();
-            if last.is_some() {
-                dirty.fill(Columns::NONE);
-            }
-            for (i, fresh) in fresh.into_iter().enumerate() {
-                if let Some(p) = fresh {
-                    let reach: Vec<f64> = match &last {
-                        Some(d) => (0..bands).map(|b| d.reach[b * nl + i]).collect(),
-                        None => Vec::new(),
-                    };
-                    match cache.layers[i].as_ref().map(|(_, old)| (&old.1, &p.1)) {
-                        Some((Some(old), Some(new))) if last.is_some() => {
-                            new.mark_changed_columns(old, &reach, w, &mut dirty)
-                        }
-                        Some((None, None)) => {}
-                        _ => dirty.fill(Columns::all(w)),
-                    }
-                    cache.layers[i] = Some((doc.layers[i].clone(), p));
-                }
-            }
-            // Drawn in another pixel type or size (or never): every band is drawn.
-            let same_kind = last
-                .as_ref()
-                .and_then(|d| d.pixels.downcast_ref::<Vec<P>>())
-                .is_some_and(|p| p.len() == out.len());
-            if !same_kind {
-                dirty.fill(Columns::all(w));
-                last = Some(LastImage {
-                    opts: opts.clone(),
-                    pixels: Box::new(out.to_vec()),
-                    reach: vec![f64::NEG_INFINITY; bands * nl],
-                });
-            }
-            last_slot = Some(&mut cache.drawn);
-            // Every entry was just filled or matched.
-            cache
-                .layers
-                .iter()
-                .map(|entry| &entry.as_ref().expect("filled or matched above").1)
-                .collect()
+            let through = draw_through_cache(cache, doc, opts, fresh, out, &mut dirty);
+            last = through.last;
+            last_slot = Some(through.slot);
+            through.prepared
         }
         None => {
             kept = fresh
@@ -325,9 +229,181 @@ fn render<P: OutputPixel>(
             kept.iter().collect()
         }
     };
+    let (mut info, layers, layer_of) = describe_layers(prepared, reused);
+    info.timings.prepare = start.elapsed();
+
+    let start = Instant::now();
+    let drawer = BandDrawer {
+        width: w,
+        layers: &layers,
+        layer_of: &layer_of,
+        opts,
+        background: premultiplied_background(opts),
+    };
+    drawer.draw_bands(out, last.as_mut(), &dirty, nl);
+    info.drawn_bands = dirty.iter().filter(|c| !c.is_empty()).count();
+    info.drawn_pixels = (0..bands)
+        .map(|b| dirty[b].len() as u64 * (h - b * BAND).min(BAND) as u64)
+        .sum();
+    if let Some(slot) = last_slot {
+        *slot = last;
+    }
+    info.timings.draw = start.elapsed();
+    Ok(info)
+}
+
+/// Refuses an output buffer that does not hold the image `opts` describe.
+fn check_output_buffer(opts: &RenderOptions, len: usize) -> Result<(), Error> {
+    let (w, h) = (opts.width as usize, opts.height as usize);
+    if len != 4 * w * h {
+        return Err(ErrorKind::Invalid {
+            what: "output buffer".into(),
+            message: format!(
+                "holds {len} channels, a {w}x{h} RGBA image needs {}",
+                4 * w * h
+            ),
+        }
+        .into());
+    }
+    Ok(())
+}
+
+/// Readies `cache` for a render of `doc` with `opts`: entries prepared with other options go,
+/// and so does the last image if the layers or drawing options changed.
+fn ready_cache(cache: &mut RenderCache, doc: &Document, opts: &RenderOptions) {
+    let key = RenderCache::key(opts);
+    if cache.key.as_ref() != Some(&key) {
+        cache.key = Some(key);
+        cache.layers.clear();
+        cache.plans.clear();
+    }
+    // A document with other layers, or other drawing options, draws every band again.
+    if cache.layers.len() != doc.layers.len()
+        || cache.drawn.as_ref().is_some_and(|d| d.opts != *opts)
+    {
+        cache.drawn = None;
+    }
+    cache.layers.resize_with(doc.layers.len(), || None);
+    cache.plans.resize_with(doc.layers.len(), Default::default);
+    if cache.shapes.len() > MAX_CACHED_SHAPES {
+        cache.shapes = Arc::default();
+    }
+}
+
+/// Prepares the layers of `doc` in parallel; `None` for a layer `cache` holds unchanged.
+fn prepare_layers(
+    doc: &Document,
+    opts: &RenderOptions,
+    xf: &ToPixels,
+    cache: Option<&mut RenderCache>,
+) -> Result<Vec<Option<layer::LayerPreparation>>, Error> {
+    let shapes: Arc<ShapeCache> = cache
+        .as_deref()
+        .map(|c| Arc::clone(&c.shapes))
+        .unwrap_or_default();
+    let (cached, mut memos) = match cache {
+        Some(c) => (
+            Some(c.layers.as_slice()),
+            c.plans.iter_mut().map(Some).collect(),
+        ),
+        None => (
+            None,
+            (0..doc.layers.len()).map(|_| None).collect::<Vec<_>>(),
+        ),
+    };
+    doc.layers
+        .par_iter()
+        .zip(memos.par_iter_mut())
+        .enumerate()
+        .map(|(i, (mesh, memo))| {
+            let entry = cached.and_then(|c| c[i].as_ref());
+            if entry.is_some_and(|(old, _)| old == mesh) {
+                return Ok(None);
+            }
+            // Plans are kept for layers prepared again (edited): keeping every layer's would
+            // cost a copy of its plans at its first preparation, and memory, for nothing.
+            let memo = memo.as_deref_mut().filter(|_| entry.is_some());
+            layer::prepare(mesh, i, opts, xf, &shapes, memo).map(Some)
+        })
+        .collect::<Vec<_>>()
+        // The first failing layer's error, whatever the thread count.
+        .into_iter()
+        .collect()
+}
+
+/// What a render through a cache draws with: the last image drawn (or a fresh one), the
+/// cache's slot to put it back into, and every layer prepared.
+struct ThroughCache<'c> {
+    last: Option<LastImage>,
+    slot: &'c mut Option<LastImage>,
+    prepared: Vec<&'c layer::LayerPreparation>,
+}
+
+/// Puts the `fresh` layers into `cache` and marks in `dirty` the columns of each band that
+/// they draw differently from the last image (every column if there is none to compare with).
+fn draw_through_cache<'c, P: OutputPixel>(
+    cache: &'c mut RenderCache,
+    doc: &Document,
+    opts: &RenderOptions,
+    fresh: Vec<Option<layer::LayerPreparation>>,
+    out: &[P],
+    dirty: &mut [Columns],
+) -> ThroughCache<'c> {
+    let (w, bands) = (opts.width as usize, dirty.len());
+    let nl = doc.layers.len().max(1);
+    let mut last = cache.drawn.take();
+    if last.is_some() {
+        dirty.fill(Columns::NONE);
+    }
+    for (i, fresh) in fresh.into_iter().enumerate() {
+        if let Some(p) = fresh {
+            let reach: Vec<f64> = match &last {
+                Some(d) => (0..bands).map(|b| d.reach[b * nl + i]).collect(),
+                None => Vec::new(),
+            };
+            match cache.layers[i].as_ref().map(|(_, old)| (&old.1, &p.1)) {
+                Some((Some(old), Some(new))) if last.is_some() => {
+                    new.mark_changed_columns(old, &reach, w, dirty)
+                }
+                Some((None, None)) => {}
+                _ => dirty.fill(Columns::all(w)),
+            }
+            cache.layers[i] = Some((doc.layers[i].clone(), p));
+        }
+    }
+    // LastImage in another pixel type or size (or never): every band is drawn.
+    let same_kind = last
+        .as_ref()
+        .and_then(|d| d.pixels.downcast_ref::<Vec<P>>())
+        .is_some_and(|p| p.len() == out.len());
+    if !same_kind {
+        dirty.fill(Columns::all(w));
+        last = Some(LastImage {
+            opts: opts.clone(),
+            pixels: Box::new(out.to_vec()),
+            reach: vec![f64::NEG_INFINITY; bands * nl],
+        });
+    }
+    let RenderCache { layers, drawn, .. } = cache;
+    ThroughCache {
+        last,
+        slot: drawn,
+        // Every entry was just filled or matched.
+        prepared: layers
+            .iter()
+            .map(|entry| &entry.as_ref().expect("filled or matched above").1)
+            .collect(),
+    }
+}
+
+/// The render's description of each layer, the layers with something to draw, and the
+/// document's index of each of those.
+fn describe_layers(
+    prepared: Vec<&layer::LayerPreparation>,
+    reused: Vec<bool>,
+) -> (RenderInfo, Vec<&DrawableLayer>, Vec<usize>) {
     let mut info = RenderInfo::default();
     let mut layers: Vec<&DrawableLayer> = Vec::new();
-    // The document's index of each layer drawn (those with nothing to draw are left out).
     let mut layer_of: Vec<usize> = Vec::new();
     for ((layer_info, layer, warnings), reused) in prepared.into_iter().zip(reused) {
         let mut layer_info = layer_info.clone();
@@ -343,9 +419,12 @@ fn render<P: OutputPixel>(
             layers.push(layer);
         }
     }
-    info.timings.prepare = start.elapsed();
+    (info, layers, layer_of)
+}
 
-    let background = opts.background.map(|bg| {
+/// The background of `opts`, clamped and premultiplied in the blend space.
+fn premultiplied_background(opts: &RenderOptions) -> Option<[f32; 4]> {
+    opts.background.map(|bg| {
         let a = bg[3].clamp(0.0, 1.0);
         let rgb = [bg[0], bg[1], bg[2]].map(|c| c.clamp(0.0, 1.0));
         let rgb = match opts.blend {
@@ -353,22 +432,36 @@ fn render<P: OutputPixel>(
             BlendSpace::Linear => rgb.map(srgb_decode),
         };
         [rgb[0] * a, rgb[1] * a, rgb[2] * a, a].map(|v| v as f32)
-    });
-    let start = Instant::now();
-    // Draws columns `cols` of a band, and puts in `reach` (per layer of the document) what
-    // [`Band::reach`] gets: for part of the band, the farther of that and what it held (the
-    // other columns' outline pixels keep theirs).
-    let draw = |band: usize, cols: Columns, chunk: &mut [P], reach: &mut [f64]| {
-        let mut drawn_reach = vec![f64::NEG_INFINITY; layers.len()];
+    })
+}
+
+/// Draws the bands of an image.
+struct BandDrawer<'a> {
+    width: usize,
+    /// The layers with something to draw, bottom first.
+    layers: &'a [&'a DrawableLayer],
+    /// The document's index of each of `layers`.
+    layer_of: &'a [usize],
+    opts: &'a RenderOptions,
+    background: Option<[f32; 4]>,
+}
+
+impl BandDrawer<'_> {
+    /// Draws columns `cols` of a band, and puts in `reach` (per layer of the document) what
+    /// [`Band::reach`] gets: for part of the band, the farther of that and what it held (the
+    /// other columns' outline pixels keep theirs).
+    fn draw<P: OutputPixel>(&self, band: usize, cols: Columns, chunk: &mut [P], reach: &mut [f64]) {
+        let w = self.width;
+        let mut drawn_reach = vec![f64::NEG_INFINITY; self.layers.len()];
         Scratch::with(w, |scratch| {
             let job = Band {
                 wide: false,
                 index: band,
                 columns: cols.start..cols.end,
                 out: chunk,
-                layers: &layers,
-                opts,
-                background,
+                layers: self.layers,
+                opts: self.opts,
+                background: self.background,
                 reach: &mut drawn_reach,
             };
             draw_band_dispatched(job, scratch)
@@ -376,48 +469,54 @@ fn render<P: OutputPixel>(
         if cols == Columns::all(w) {
             reach.fill(f64::NEG_INFINITY);
         }
-        for (&i, r) in layer_of.iter().zip(drawn_reach) {
+        for (&i, r) in self.layer_of.iter().zip(drawn_reach) {
             reach[i] = reach[i].max(r);
         }
-    };
-    let chunks = out.par_chunks_mut(4 * w * BAND).enumerate();
-    let kept = last.as_mut().and_then(|LastImage { pixels, reach, .. }| {
-        Some((pixels.downcast_mut::<Vec<P>>()?, reach))
-    });
-    match kept {
-        // Pixels drawn again are kept for the next render; the others are taken from the last.
-        Some((pixels, reach)) => chunks
-            .zip(pixels.par_chunks_mut(4 * w * BAND))
-            .zip(reach.par_chunks_mut(nl))
-            .for_each(|(((band, chunk), last), reach)| {
-                let cols = dirty[band];
-                if cols == Columns::all(w) {
-                    draw(band, cols, chunk, reach);
-                    last.copy_from_slice(chunk);
-                    return;
-                }
-                chunk.copy_from_slice(last);
-                if !cols.is_empty() {
-                    draw(band, cols, chunk, reach);
-                    let window = 4 * cols.start..4 * cols.end;
-                    for (last, row) in last.chunks_exact_mut(4 * w).zip(chunk.chunks_exact(4 * w)) {
-                        last[window.clone()].copy_from_slice(&row[window.clone()]);
+    }
+
+    /// Draws the `dirty` columns of every band of `out` in parallel. With a `last` image of
+    /// the same pixel type, the other columns are copied from it, and what is drawn again is
+    /// kept in it for the next render.
+    fn draw_bands<P: OutputPixel>(
+        &self,
+        out: &mut [P],
+        last: Option<&mut LastImage>,
+        dirty: &[Columns],
+        nl: usize,
+    ) {
+        let w = self.width;
+        let chunks = out.par_chunks_mut(4 * w * BAND).enumerate();
+        let kept = last.and_then(|LastImage { pixels, reach, .. }| {
+            Some((pixels.downcast_mut::<Vec<P>>()?, reach))
+        });
+        match kept {
+            // Pixels drawn again are kept for the next render; the others are taken from the last.
+            Some((pixels, reach)) => chunks
+                .zip(pixels.par_chunks_mut(4 * w * BAND))
+                .zip(reach.par_chunks_mut(nl))
+                .for_each(|(((band, chunk), last), reach)| {
+                    let cols = dirty[band];
+                    if cols == Columns::all(w) {
+                        self.draw(band, cols, chunk, reach);
+                        last.copy_from_slice(chunk);
+                        return;
                     }
-                }
+                    chunk.copy_from_slice(last);
+                    if !cols.is_empty() {
+                        self.draw(band, cols, chunk, reach);
+                        let window = 4 * cols.start..4 * cols.end;
+                        for (last, row) in
+                            last.chunks_exact_mut(4 * w).zip(chunk.chunks_exact(4 * w))
+                        {
+                            last[window.clone()].copy_from_slice(&row[window.clone()]);
+                        }
+                    }
+                }),
+            None => chunks.for_each(|(band, chunk)| {
+                self.draw(band, Columns::all(w), chunk, &mut vec![0.0; nl])
             }),
-        None => {
-            chunks.for_each(|(band, chunk)| draw(band, Columns::all(w), chunk, &mut vec![0.0; nl]))
         }
     }
-    info.drawn_bands = dirty.iter().filter(|c| !c.is_empty()).count();
-    info.drawn_pixels = (0..bands)
-        .map(|b| dirty[b].len() as u64 * (h - b * BAND).min(BAND) as u64)
-        .sum();
-    if let Some(slot) = last_slot {
-        *slot = last;
-    }
-    info.timings.draw = start.elapsed();
-    Ok(info)
 }
 
 /// `[f(0), f(1), f(2)]`. Written out: in the hottest loops `array::map` and `array::from_fn`
