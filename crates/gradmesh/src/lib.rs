@@ -39,16 +39,17 @@ mod colour;
 mod edit_check;
 mod edits;
 mod error;
+mod folds;
 pub mod formats;
 mod level;
-mod limit;
-mod limits;
+mod limit_surface;
 mod mesh;
 mod multires;
 mod refine;
 pub mod render;
 mod rules;
 mod scheme;
+mod size_limits;
 mod ternary_step;
 mod topology;
 mod validate;
@@ -56,11 +57,11 @@ mod validate;
 pub use colour::{parse_css_colour, ColourSpace};
 pub use edit_check::EditSet;
 pub use error::{Error, ErrorKind, Location, Result, Warning};
-pub use limits::Limits;
 pub use mesh::{ControlPoint, Document, EdgeKind, EdgeTag, GradientMesh, WedgeOverride};
 pub use multires::{ColourEdit, Edit, FineEdits, OpacityEdit, VertexAddress, MAX_EDIT_LEVEL};
 pub use refine::{refine_level, LevelPoints, RefinedData, RefinedLevel, Refinement};
 pub use scheme::{BoundaryInterpolation, CreasingMethod, FirstStep, SHARPNESS_INFINITE};
+pub use size_limits::Limits;
 pub use topology::Topology;
 pub use validate::{validate, BaseMesh, VertexData};
 
@@ -83,11 +84,11 @@ pub mod internals {
     }
     /// Limit stencils.
     pub mod limit {
-        pub use crate::limit::*;
+        pub use crate::limit_surface::*;
     }
     /// Refinement size estimates.
     pub mod limits {
-        pub use crate::limits::*;
+        pub use crate::size_limits::*;
     }
     /// Pixar's subdivision rules.
     pub mod rules {

@@ -14,11 +14,11 @@ use crate::colour::ColourSpace;
 use crate::edit_check::check_edits;
 use crate::edits;
 use crate::error::{Error, Warning};
-use crate::limit;
-use crate::limits::Limits;
+use crate::limit_surface;
 use crate::mesh::{FirstStep, GradientMesh};
 use crate::multires::{Edit, FineEdits};
 use crate::rules;
+use crate::size_limits::Limits;
 use crate::ternary_step;
 use crate::topology::Topology;
 use crate::validate::{BaseMesh, VertexData};
@@ -98,7 +98,8 @@ impl Refinement {
                 d += 1;
                 r.extend_to(d);
             }
-            let limit = limit::limit_stencils(r.level(d)).expect("level 2 and below are quads");
+            let limit =
+                limit_surface::limit_stencils(r.level(d)).expect("level 2 and below are quads");
             r.interpolation = Some((d, limit));
         }
         r
@@ -332,7 +333,7 @@ impl Refinement {
         };
         loop {
             if j >= 1 && j >= exact_from {
-                if let Some(st) = limit::limit_stencils(self.level(j)) {
+                if let Some(st) = limit_surface::limit_stencils(self.level(j)) {
                     let at_j = self.level_data(data, j);
                     let all = st.apply(&at_j);
                     return index.iter().map(|&i| all[i as usize]).collect();

@@ -14,12 +14,12 @@ use serde::de::{self, Deserialize, Deserializer, IgnoredAny, MapAccess, SeqAcces
 
 use crate::colour::{parse_css_colour, ColourSpace};
 use crate::error::{Error, ErrorKind, Location};
-use crate::limits::Limits;
 use crate::mesh::{
     edge_key, BoundaryInterpolation, ControlPoint, CreasingMethod, Document, EdgeKind, EdgeTag,
     FirstStep, GradientMesh, WedgeOverride,
 };
 use crate::multires::{ColourEdit, Edit, FineEdits, OpacityEdit, VertexAddress};
+use crate::size_limits::Limits;
 use crate::topology::Topology;
 use crate::validate::VertexData;
 

@@ -14,8 +14,8 @@ use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::error::{Error, ErrorKind, Location};
-use crate::limits::Limits;
 use crate::mesh::{Document, GradientMesh};
+use crate::size_limits::Limits;
 
 /// The largest input accepted by default, in bytes (256 MiB): [`Limits::input_bytes`].
 pub const MAX_INPUT_BYTES: u64 = Limits::DEFAULT.input_bytes;

@@ -14,8 +14,8 @@ use kurbo::Point;
 
 use crate::colour::ColourSpace;
 use crate::error::{Error, ErrorKind};
-use crate::limits::Limits;
 use crate::mesh::{BoundaryInterpolation, ControlPoint, CreasingMethod, EdgeKind, GradientMesh};
+use crate::size_limits::Limits;
 use crate::topology::Topology;
 use crate::validate::VertexData;
 

@@ -18,8 +18,8 @@ use kurbo::{Point, Vec2};
 
 use crate::colour::ColourSpace;
 use crate::error::{Error, ErrorKind};
-use crate::limits::Limits;
 use crate::mesh::{edge_key, ControlPoint, GradientMesh};
+use crate::size_limits::Limits;
 
 use super::{check_count, check_size, error_at, syntax_error};
 

@@ -2,7 +2,7 @@
 //!
 //! 1. **Density** ([`super::face_plans`]). Each face of the base level ([`BASE_LEVEL`],
 //!    shallower for meshes dense for the image: see [`base_level`]) is evaluated on grids of
-//!    `1, 2, 4, ..` cells a side ([`patches`](super::patches): a B-spline patch where the face
+//!    `1, 2, 4, ..` cells a side ([`patches`](crate::limit_surface::patches): a B-spline patch where the face
 //!    is regular, local refinement elsewhere) until its cells pass the same measure as the
 //!    uniform path's quads (colour at cell and side centres against the triangles, cell size,
 //!    outline). A face whose control points all lie off the image stays at one cell.
@@ -36,10 +36,10 @@ use crate::validate::VertexData;
 use super::face_plans::{CachedPlan, EarlierPlans, FacePlanner, FacePlans};
 use super::measure::{Measure, Thresholds};
 use super::nearest::Segment;
-use super::patches::ShapeCache;
 use super::stitch::{colour_bounds, Stitching};
 use super::triangles::{Bounds, Triangle, TriangleList};
 use super::view::ToPixels;
+use crate::limit_surface::patches::ShapeCache;
 
 /// The level whose faces get their own density: all quads, extraordinary vertices isolated,
 /// and faces small enough that irregular ones (refined locally) cover little of the layer.

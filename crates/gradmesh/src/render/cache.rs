@@ -9,7 +9,7 @@ use super::adaptive;
 use super::gamut::{BlendSpace, GamutMapping};
 use super::layer;
 use super::options::RenderOptions;
-use super::patches::ShapeCache;
+use crate::limit_surface::patches::ShapeCache;
 
 /// Layers prepared for drawing (refined, tessellated and binned), kept between renders of a
 /// document being edited: [`render_document_into_cached`](super::render_document_into_cached) prepares again only the layers whose

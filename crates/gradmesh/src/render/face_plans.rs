@@ -13,11 +13,11 @@ use crate::validate::VertexData;
 
 use super::each4;
 use super::measure::{measure_quad, Measure, QuadSamples, Thresholds};
-use super::patches::{
-    regular_corners, regular_patch_with, ControlGrid, Grid, LocalPatch, ShapeCache,
-};
 use super::quadratic::{measure_cells, Cell};
 use super::view::ToPixels;
+use crate::limit_surface::patches::{
+    regular_corners, regular_patch_with, ControlGrid, Grid, LocalPatch, ShapeCache,
+};
 
 /// Quadratic colour is tried on a face only while its linear error is at most this many times
 /// the tolerance: with larger errors the quarter points that check it can miss a steep colour
@@ -63,7 +63,7 @@ impl FaceSurface {
 
     fn grid(&mut self, n: usize) -> Option<Grid> {
         match self {
-            FaceSurface::Regular(cp) => Some(super::patches::evaluate_patch(cp, n)),
+            FaceSurface::Regular(cp) => Some(crate::limit_surface::patches::evaluate_patch(cp, n)),
             FaceSurface::Local { patch, root } => patch.grid(*root, n),
         }
     }
@@ -71,7 +71,9 @@ impl FaceSurface {
     /// [`FaceSurface::grid`] into `out`, whose memory a regular patch reuses.
     fn grid_into(&mut self, n: usize, out: &mut Grid) -> Option<()> {
         match self {
-            FaceSurface::Regular(cp) => super::patches::evaluate_patch_into(cp, n, out),
+            FaceSurface::Regular(cp) => {
+                crate::limit_surface::patches::evaluate_patch_into(cp, n, out)
+            }
             FaceSurface::Local { patch, root } => *out = patch.grid(*root, n)?,
         }
         Some(())

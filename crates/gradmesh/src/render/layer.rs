@@ -7,10 +7,10 @@ use rayon::prelude::*;
 
 use crate::colour::ColourSpace;
 use crate::error::{Error, Warning};
-use crate::limit;
-use crate::limits::Limits;
+use crate::limit_surface;
 use crate::mesh::GradientMesh;
 use crate::refine::{RefinedData, Refinement};
+use crate::size_limits::Limits;
 use crate::topology::Topology;
 use crate::validate::{attributes, BaseMesh, VertexData, COLOUR, X, Y};
 
@@ -19,10 +19,10 @@ use super::coverage::Line;
 use super::measure::{measure, Measure, Thresholds, MIN_QUAD_PX};
 use super::nearest::{NearestSegments, Segment};
 use super::outline::{boundary_loops, outline};
-use super::patches::ShapeCache;
 use super::triangles::{screen_triangle_px, snap, Bounds, Triangle, TriangleList, UNBOUNDED};
 use super::view::ToPixels;
 use super::{LayerInfo, LayerTimings, RenderOptions};
+use crate::limit_surface::patches::ShapeCache;
 
 /// Rows per band: the unit of parallel work.
 pub(crate) const BAND: usize = 16;
@@ -271,7 +271,7 @@ fn forced_level(base: &BaseMesh, forced: usize) -> usize {
 
 /// The limit data of level `k >= 2` (all quads), without copying the level's data.
 fn limit_of(refinement: &mut Refinement, data: &RefinedData, k: usize) -> Vec<VertexData> {
-    match limit::limit_stencils(refinement.level(k)) {
+    match limit_surface::limit_stencils(refinement.level(k)) {
         Some(st) => st.apply(&data.levels[k]),
         None => refinement.limit(data, k),
     }

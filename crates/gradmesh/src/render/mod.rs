@@ -95,7 +95,6 @@ mod cache;
 mod composite;
 mod coverage;
 mod face_plans;
-mod folds;
 mod gamut;
 mod info;
 mod layer;
@@ -105,7 +104,6 @@ mod options;
 mod outline;
 mod output;
 mod overlay;
-mod patches;
 mod quadratic;
 mod stitch;
 mod triangles;
@@ -123,8 +121,8 @@ use crate::colour::srgb_decode;
 use crate::error::{Error, ErrorKind};
 use crate::mesh::{Document, GradientMesh};
 
+pub use crate::folds::{find_folds, find_folds_at, Fold, FOLD_LEVEL};
 pub use cache::RenderCache;
-pub use folds::{find_folds, find_folds_at, Fold, FOLD_LEVEL};
 pub use gamut::{BlendSpace, GamutMapping};
 pub use info::{LayerInfo, LayerTimings, RenderInfo, RenderTimings};
 pub use options::{
@@ -138,10 +136,10 @@ pub use output::{
 pub use overlay::draw_outlines;
 pub use view::{document_bounds, View};
 
+use crate::limit_surface::patches::ShapeCache;
 use cache::{LastImage, MAX_CACHED_SHAPES};
 use composite::{draw_band, Band, Scratch};
 use layer::{Columns, DrawableLayer, BAND};
-use patches::ShapeCache;
 use view::ToPixels;
 
 /// Renders `doc` into a new `f32` image: straight alpha, sRGB-encoded colour.

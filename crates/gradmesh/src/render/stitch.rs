@@ -12,11 +12,11 @@ use crate::validate::VertexData;
 
 use super::face_plans::{each_face, edge_counts, CellOrders, FacePlanner, FacePlans, Order, Plan};
 use super::nearest::Segment;
-use super::patches::Grid;
 use super::quadratic::{chord_node, screen_gradient, Cell, Quadratic};
 use super::triangles::{snap, Bounds, Triangle, UNBOUNDED};
 use super::view::ToPixels;
 use super::{each3, each4};
+use crate::limit_surface::patches::Grid;
 
 /// The grid position of parameter `s` (`0..=m`) along side `k` of a face, from its corner `k`
 /// to its corner `k + 1`.

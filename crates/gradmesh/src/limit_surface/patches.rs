@@ -19,7 +19,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use crate::catmull_clark::{self, Stencils};
 use crate::level::Level;
-use crate::limit;
+use crate::limit_surface as limit;
 use crate::mesh::{BoundaryInterpolation, CreasingMethod};
 use crate::rules::{self, VertexRule};
 use crate::topology::Topology;
@@ -323,7 +323,7 @@ impl Tile {
             [o[0] + 2 * (u[0] + v[0]), o[1] + 2 * (u[1] + v[1])],
             [o[0] + 2 * v[0], o[1] + 2 * v[1]],
         ];
-        super::each4(|c| {
+        std::array::from_fn(|c| {
             let p = corners[c];
             let towards = |q: [i64; 2]| [(q[0] - p[0]) / 2, (q[1] - p[1]) / 2];
             Tile {
@@ -361,7 +361,7 @@ struct ShapeDepth {
 /// The local refinement of one shape of neighbourhood, deepened as far as some face asks.
 ///
 /// Its depths are built under a lock, and a [`LocalPatch`] is refined further under its
-/// owner's lock ([`super::face_plans`]): nothing under them waits in rayon (the `_sequential`
+/// owner's lock (the renderer's face planning): nothing under them waits in rayon (the `_sequential`
 /// subdivision and stencils), since a thread waiting there may take on a task that wants the
 /// same lock, and deadlock.
 struct LocalShape {

@@ -1,4 +1,7 @@
-//! Limit stencils: where each vertex of an all-quad level ends up on the limit surface.
+//! Evaluating the limit surface: limit stencils (here), where each vertex of an all-quad level
+//! ends up, and [`patches`], the surface face by face as bicubic patches or local refinement.
+//!
+//! Limit stencils:
 //!
 //! * smooth vertex of valence `n`: `(n^2 V + 4 sum(E_i) + sum(D_i)) / (n (n + 5))`, with `E_i`
 //!   its edge neighbours and `D_i` the diagonal corners of its quads;
@@ -9,6 +12,8 @@
 //! * corner: `V`.
 //!
 //! As in OpenSubdiv, a semi-sharp feature still present at the level counts as sharp.
+
+pub(crate) mod patches;
 
 use std::collections::HashMap;
 
