@@ -238,8 +238,8 @@ fn cases() -> Vec<Case> {
         }),
     ];
     // ---- files, refinement, rendering, writing
-    c.push(other("Io", "read_path", "`picture.svg`", || {
-        formats::read_path(Path::new("picture.svg")).map(drop)
+    c.push(other("Io", "read_path", "`picture.png`", || {
+        formats::read_path(Path::new("picture.png")).map(drop)
     }));
     c.push(other(
         "Io",
