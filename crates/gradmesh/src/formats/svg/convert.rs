@@ -44,29 +44,7 @@ pub fn fill_to_layer(fill: &MeshFill, space: ColourSpace) -> (GradientMesh, Vec<
     let grid = &fill.mesh;
     let (rows, columns) = (grid.rows, grid.columns);
     let index = |i: usize, j: usize| i * (columns + 1) + j;
-    let bounds = grid.control_bounds();
-    let tolerance = 1e-9 * bounds.width().max(bounds.height()).max(1.0);
-    let degenerate = |s: &CubicBez| {
-        [s.p1, s.p2, s.p3]
-            .iter()
-            .all(|p| p.distance(s.p0) <= tolerance)
-    };
-
-    let mut merged = UnionFind::new(grid.corners.len());
-    for i in 0..=rows {
-        for j in 0..columns {
-            if degenerate(&grid.row_side(i, j)) {
-                merged.union(index(i, j), index(i, j + 1));
-            }
-        }
-    }
-    for i in 0..rows {
-        for j in 0..=columns {
-            if degenerate(&grid.column_side(i, j)) {
-                merged.union(index(i, j), index(i + 1, j));
-            }
-        }
-    }
+    let mut merged = corners_joined_by_empty_sides(grid);
 
     let mut notes = Vec::new();
     let mut mesh = GradientMesh::new(space);
@@ -143,6 +121,37 @@ pub fn fill_to_layer(fill: &MeshFill, space: ColourSpace) -> (GradientMesh, Vec<
         }
     }
     (mesh, notes)
+}
+
+/// The corners in sets joined by sides of zero length (all four control points within a
+/// billionth of the mesh's size of each other).
+fn corners_joined_by_empty_sides(grid: &MeshGrid) -> UnionFind {
+    let (rows, columns) = (grid.rows, grid.columns);
+    let index = |i: usize, j: usize| i * (columns + 1) + j;
+    let bounds = grid.control_bounds();
+    let tolerance = 1e-9 * bounds.width().max(bounds.height()).max(1.0);
+    let degenerate = |s: &CubicBez| {
+        [s.p1, s.p2, s.p3]
+            .iter()
+            .all(|p| p.distance(s.p0) <= tolerance)
+    };
+
+    let mut merged = UnionFind::new(grid.corners.len());
+    for i in 0..=rows {
+        for j in 0..columns {
+            if degenerate(&grid.row_side(i, j)) {
+                merged.union(index(i, j), index(i, j + 1));
+            }
+        }
+    }
+    for i in 0..rows {
+        for j in 0..=columns {
+            if degenerate(&grid.column_side(i, j)) {
+                merged.union(index(i, j), index(i + 1, j));
+            }
+        }
+    }
+    merged
 }
 
 /// The largest angle, in radians, between the two sides at a corner on the grid's outline for
