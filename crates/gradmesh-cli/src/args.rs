@@ -21,7 +21,7 @@ pub struct Cli {
 pub enum Command {
     /// Print counts, face sizes, valences, bounds, colour space and warnings of meshes.
     Info(InfoArgs),
-    /// Convert a mesh (.json, .off, .obj) to the native JSON format.
+    /// Convert a mesh (.json, .off, .obj, .svg) to the native JSON format.
     Convert(ConvertArgs),
     /// Write the refined control mesh (or its limit points) at a given level.
     Refine(RefineArgs),
@@ -152,7 +152,7 @@ impl From<GamutArg> for GamutMapping {
 /// `gradmesh info`.
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// Input files (.json, .off, .obj).
+    /// Input files (.json, .off, .obj, .svg).
     #[arg(required = true)]
     pub inputs: Vec<PathBuf>,
     /// Limits.
@@ -173,7 +173,7 @@ pub struct EditsArgs {
 /// `gradmesh convert`.
 #[derive(Debug, Args)]
 pub struct ConvertArgs {
-    /// Input file (.json, .off, .obj).
+    /// Input file (.json, .off, .obj, .svg).
     pub input: PathBuf,
     /// Output file (.json).
     #[arg(short, long)]
@@ -192,7 +192,7 @@ pub struct ConvertArgs {
 /// `gradmesh refine`.
 #[derive(Debug, Args)]
 pub struct RefineArgs {
-    /// Input file (.json, .off, .obj).
+    /// Input file (.json, .off, .obj, .svg).
     pub input: PathBuf,
     /// Output file: .obj (`v x y 0 c1 c2 c3` and `f` lines) or .json.
     #[arg(short, long)]
@@ -223,7 +223,7 @@ pub struct RefineArgs {
 /// `gradmesh render`.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// Input files (.json, .off, .obj), drawn in order: the first at the bottom.
+    /// Input files (.json, .off, .obj, .svg), drawn in order: the first at the bottom.
     #[arg(required = true)]
     pub inputs: Vec<PathBuf>,
     /// Output file (.png).

@@ -37,8 +37,15 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
     }
 }
 
-/// Reads a document within `limits`, with errors located in the file.
+/// Reads a document within `limits`, with errors located in the file. An SVG file's warnings
+/// (what was left out) are printed.
 fn read(path: &Path, limits: &gradmesh::Limits) -> Result<Document, Error> {
+    use gradmesh::formats::{svg, Format};
+    if Format::from_path(path) == Some(Format::Svg) {
+        let (doc, warnings) = svg::read_path_with_limits(path, limits)?;
+        print_warnings(path, &warnings);
+        return Ok(doc);
+    }
     gradmesh::formats::read_path_with_limits(path, limits)
 }
 

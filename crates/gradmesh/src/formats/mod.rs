@@ -1,4 +1,5 @@
-//! Reading and writing gradient meshes: the native JSON format, the authors' OFF, and OBJ.
+//! Reading and writing gradient meshes: the native JSON format, the authors' OFF, OBJ, and
+//! mesh gradients from SVG.
 //!
 //! The native format is specified in `docs/format.md`. Every reader reports errors with the line
 //! they occur on, and refuses input beyond its [`Limits`] (the `_with_limits` functions; the others use
@@ -7,6 +8,7 @@
 pub mod json;
 pub mod obj;
 pub mod off;
+pub mod svg;
 
 use std::fs;
 use std::io::{Read, Write};
@@ -35,11 +37,13 @@ pub enum Format {
     Off,
     /// Wavefront OBJ polygon meshes (`.obj`), read; refined meshes are written.
     Obj,
+    /// SVG mesh gradients (`.svg`), read: one layer per shape filled with a mesh gradient.
+    Svg,
 }
 
 impl Format {
     /// Every format.
-    pub const ALL: [Format; 3] = [Format::Json, Format::Off, Format::Obj];
+    pub const ALL: [Format; 4] = [Format::Json, Format::Off, Format::Obj, Format::Svg];
 
     /// The format of a path, from its extension (case-insensitive).
     pub fn from_path(path: &Path) -> Option<Format> {
@@ -59,6 +63,7 @@ impl Format {
             Format::Json => "json",
             Format::Off => "off",
             Format::Obj => "obj",
+            Format::Svg => "svg",
         }
     }
 }
@@ -80,6 +85,8 @@ pub fn read_str_with_limits(
         Format::Json => json::read_document_with_limits(text, limits),
         Format::Off => off::read_off_with_limits(text, limits).map(single_layer),
         Format::Obj => obj::read_obj_with_limits(text, limits).map(single_layer),
+        Format::Svg => svg::read_document_with_limits(text, crate::ColourSpace::Lab, limits)
+            .map(|(doc, _)| doc),
     }
 }
 
@@ -103,12 +110,12 @@ fn read_path_unlocated(path: &Path, limits: &Limits) -> Result<Document, Error> 
             None => "no extension".to_string(),
         };
         Error::new(ErrorKind::UnsupportedFormat(format!(
-            "cannot tell the format from {found}: expected .json, .off or .obj"
+            "cannot tell the format from {found}: expected .json, .off, .obj or .svg"
         )))
     })?;
     let text = read_text(path, limits.input_bytes)?;
     let mut doc = read_str_with_limits(&text, format, limits)?;
-    if format != Format::Json {
+    if matches!(format, Format::Off | Format::Obj) {
         if let Some(stem) = path.file_stem() {
             for layer in &mut doc.layers {
                 layer.name = Some(stem.to_string_lossy().into_owned());
@@ -299,16 +306,17 @@ mod tests {
         assert_eq!(Format::from_path(Path::new("a/b.json")), Some(Format::Json));
         assert_eq!(Format::from_path(Path::new("B.OFF")), Some(Format::Off));
         assert_eq!(Format::from_path(Path::new("x.Obj")), Some(Format::Obj));
-        assert_eq!(Format::from_path(Path::new("x.svg")), None);
+        assert_eq!(Format::from_path(Path::new("x.SVG")), Some(Format::Svg));
+        assert_eq!(Format::from_path(Path::new("x.png")), None);
         assert_eq!(Format::from_path(Path::new("json")), None);
     }
 
     #[test]
     fn unknown_extension_is_named() {
-        let e = read_path(Path::new("/nonexistent/picture.svg")).unwrap_err();
+        let e = read_path(Path::new("/nonexistent/picture.png")).unwrap_err();
         let text = e.to_string();
         assert!(
-            text.contains("\".svg\"") && text.contains("picture.svg"),
+            text.contains("\".png\"") && text.contains("picture.png"),
             "{text}"
         );
     }

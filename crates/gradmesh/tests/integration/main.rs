@@ -29,5 +29,6 @@ mod properties;
 mod reference_images;
 mod reference_outputs;
 mod render;
+mod svg;
 mod threads;
 mod validation;

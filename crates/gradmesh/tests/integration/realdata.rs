@@ -20,6 +20,19 @@ pub fn path(name: &str) -> PathBuf {
     )
 }
 
+/// The file (or folder) `name` of `../shared/realdata/meshgradient` beside the repository, e.g.
+/// `"wpt/meshgradient-basic-001.svg"`.
+pub fn meshgradient(name: &str) -> PathBuf {
+    let crate_dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let path = crate_dir
+        .join("../../../shared/realdata/meshgradient")
+        .join(name);
+    require(
+        path,
+        &format!("meshgradient/{name} is missing from ../shared/realdata"),
+    )
+}
+
 /// `path`; panics with `what` and the path when it does not exist.
 fn require(path: PathBuf, what: &str) -> PathBuf {
     assert!(
