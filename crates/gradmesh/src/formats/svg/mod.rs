@@ -41,8 +41,8 @@ pub use scene::{Corner, FillRule, MeshFill, MeshGrid, MeshType, SvgScene};
 
 use crate::colour::ColourSpace;
 use crate::error::{Error, ErrorKind, Warning};
-use crate::size_limits::Limits;
 use crate::mesh::Document;
+use crate::size_limits::Limits;
 
 /// Reads an SVG document within the default [`Limits`].
 pub fn read_svg(text: &str) -> Result<SvgScene, Error> {
