@@ -19,7 +19,8 @@
 //!   <rect width="100" height="100" fill="url(#m)"/>
 //! </svg>"##;
 //! let scene = svg::read_svg(text)?;
-//! assert_eq!(scene.fills[0].mesh.corner(1, 1).colour, [0.0, 1.0, 0.0]);
+//! // The stops go round the patch from its top-left corner: the third is the bottom right.
+//! assert_eq!(scene.fills[0].mesh.corner(1, 1).colour, [0.0, 0.0, 1.0]);
 //! let (doc, warnings) = svg::scene_to_document(&scene, gradmesh::ColourSpace::Lab);
 //! assert_eq!((doc.layers[0].points.len(), doc.layers[0].faces.len()), (4, 1));
 //! assert!(warnings.is_empty());
