@@ -2,6 +2,7 @@
 //! buffers, converts colours to the blend space, composites the layers front to back and
 //! encodes the pixels into the output.
 
+use crate::colour::fast::srgb_encode_f32;
 use std::ops::Range;
 
 use crate::colour::ColourSpace;
@@ -823,7 +824,7 @@ fn straight_srgb<P: OutputPixel>(c: &[f32; 4], linear: bool) -> [f32; 4] {
     for ch in 0..3 {
         let v = if opaque { c[ch] } else { c[ch] / a };
         out[ch] = if linear {
-            gamut::srgb_encode_f32(v.clamp(0.0, 1.0))
+            srgb_encode_f32(v.clamp(0.0, 1.0))
         } else if P::SATURATES {
             v
         } else {
