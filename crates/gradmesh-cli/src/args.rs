@@ -235,8 +235,9 @@ pub struct RenderArgs {
     /// Image height in pixels (with only --width, derived from the view's aspect ratio).
     #[arg(long)]
     pub height: Option<u32>,
-    /// The rectangle of the plane shown: X0 Y0 is the top-left corner, y grows downward.
-    /// Default: the bounds of the meshes.
+    /// The rectangle of the plane shown: X0 Y0 is the top-left corner, y grows downward; for
+    /// an SVG file, in its user units. Default: the first input's view box if it is an SVG
+    /// file, else the bounds of the meshes.
     #[arg(long, num_args = 4, value_names = ["X0", "Y0", "X1", "Y1"], allow_negative_numbers = true)]
     pub view: Option<Vec<f64>>,
     /// Background colour (a CSS colour such as white or #202020); default transparent.

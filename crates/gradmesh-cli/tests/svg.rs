@@ -67,3 +67,62 @@ fn svg_converts_to_json_and_renders() {
         assert!(std::fs::metadata(&png).unwrap().len() > 100);
     }
 }
+
+/// The RGBA8 pixels of a PNG file, with its size.
+fn decode_png(path: &std::path::Path) -> (u32, u32, Vec<u8>) {
+    let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
+    decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+    let mut reader = decoder.read_info().unwrap();
+    let mut data = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut data).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgba, "{}", path.display());
+    data.truncate(info.buffer_size());
+    (info.width, info.height, data)
+}
+
+/// Without `--view` and a size, an SVG file renders its own viewport at its own size: the
+/// picture has the size of Inkscape's render of the same file, and where the file holds
+/// nothing but unclipped mesh fills (the W3C square and star), it covers the same pixels.
+#[test]
+fn svg_renders_its_own_viewport_by_default() {
+    let dir = tempfile::tempdir().unwrap();
+    let renders = sample("sample3.svg")
+        .parent()
+        .unwrap()
+        .join("../inkscape-1.2.2-renders");
+    for (svg, same_coverage) in [
+        (sample("sample5.svg"), false),
+        (sample("../wpt/meshgradient-basic-001.svg"), true),
+        (sample("../wpt/meshgradient-basic-005.svg"), true),
+    ] {
+        let name = svg.file_stem().unwrap().to_str().unwrap().to_string();
+        let png = dir.path().join(format!("{name}.png"));
+        let out = gradmesh(&["render", svg.to_str().unwrap(), "-o", png.to_str().unwrap()]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let (w, h, ours) = decode_png(&png);
+        let (iw, ih, inkscape) = decode_png(&renders.join(format!("{name}.png")));
+        assert_eq!((w, h), (iw, ih), "{name}: size");
+        if !same_coverage {
+            continue;
+        }
+        let covered = |data: &[u8], i: usize| data[4 * i + 3] > 127;
+        let pixels = (w * h) as usize;
+        let disagree = (0..pixels)
+            .filter(|&i| covered(&ours, i) != covered(&inkscape, i))
+            .count();
+        let inside = (0..pixels).filter(|&i| covered(&inkscape, i)).count();
+        assert!(
+            inside > pixels / 20,
+            "{name}: Inkscape covers {inside} pixels"
+        );
+        assert!(
+            disagree * 100 < inside,
+            "{name}: {disagree} of {pixels} pixels differ in coverage from Inkscape's render"
+        );
+    }
+}

@@ -40,13 +40,32 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
 /// Reads a document within `limits`, with errors located in the file. An SVG file's warnings
 /// (what was left out) are printed.
 fn read(path: &Path, limits: &gradmesh::Limits) -> Result<Document, Error> {
+    Ok(read_with_viewport(path, limits)?.0)
+}
+
+/// The part of the plane a file shows and the picture's size in pixels, where the file says
+/// (an SVG file's view box and size).
+type Viewport = (gradmesh::render::View, (f64, f64));
+
+/// [`read`], with the file's [`Viewport`] when it has one.
+fn read_with_viewport(
+    path: &Path,
+    limits: &gradmesh::Limits,
+) -> Result<(Document, Option<Viewport>), Error> {
     use gradmesh::formats::{svg, Format};
     if Format::from_path(path) == Some(Format::Svg) {
-        let (doc, warnings) = svg::read_path_with_limits(path, limits)?;
-        print_warnings(path, &warnings);
-        return Ok(doc);
+        let read = svg::read_path_with_limits(path, limits)?;
+        print_warnings(path, &read.warnings);
+        let viewport = read
+            .view
+            .map(gradmesh::render::View::from_rect)
+            .zip(read.pixel_size);
+        return Ok((read.document, viewport));
     }
-    gradmesh::formats::read_path_with_limits(path, limits)
+    Ok((
+        gradmesh::formats::read_path_with_limits(path, limits)?,
+        None,
+    ))
 }
 
 /// Refuses to write over an input unless `force` is given.

@@ -16,11 +16,18 @@ fn invalid(what: &str, message: String) -> Error {
     })
 }
 
-/// Turns the flags into render options for `doc`.
-fn options(args: &RenderArgs, doc: &Document) -> Result<RenderOptions, Error> {
-    let view = match &args.view {
-        Some(v) => View::new(v[0], v[1], v[2], v[3]),
-        None => View::fit(doc, 0.0),
+/// Turns the flags into render options for `doc`. Without `--view`, the view is the first
+/// input's viewport (an SVG file's view box) or else the document's bounds; without a size
+/// either, the picture is that viewport's size in pixels, or one pixel per unit.
+fn options(
+    args: &RenderArgs,
+    doc: &Document,
+    viewport: Option<super::Viewport>,
+) -> Result<RenderOptions, Error> {
+    let view = match (&args.view, viewport) {
+        (Some(v), _) => View::new(v[0], v[1], v[2], v[3]),
+        (None, Some((view, _))) => view,
+        (None, None) => View::fit(doc, 0.0),
     };
     if !(view.width() > 0.0 && view.height() > 0.0) {
         return Err(invalid(
@@ -34,8 +41,11 @@ fn options(args: &RenderArgs, doc: &Document) -> Result<RenderOptions, Error> {
         (Some(w), Some(h)) => (w, h),
         (Some(w), None) => (w, side(w as f64 / aspect)),
         (None, Some(h)) => (side(h as f64 * aspect), h),
-        // One pixel per unit of the plane.
-        (None, None) => (side(view.width()), side(view.height())),
+        (None, None) => match (&args.view, viewport) {
+            (None, Some((_, (w, h)))) => (side(w), side(h)),
+            // One pixel per unit of the plane.
+            _ => (side(view.width()), side(view.height())),
+        },
     };
     let mut opts = RenderOptions::new(width, height, view);
     if let Some(bg) = &args.background {
@@ -73,8 +83,13 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     // For each layer of the document: the file it came from and its index there.
     let mut origins = Vec::new();
     let limits = args.limits.limits();
-    for path in &args.inputs {
-        let layers = super::read(path, &limits)?.layers;
+    let mut viewport = None;
+    for (k, path) in args.inputs.iter().enumerate() {
+        let (read, file_viewport) = super::read_with_viewport(path, &limits)?;
+        if k == 0 {
+            viewport = file_viewport;
+        }
+        let layers = read.layers;
         origins.extend((0..layers.len()).map(|i| (path.as_path(), i)));
         doc.layers.extend(layers);
     }
@@ -88,7 +103,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         e
     };
 
-    let opts = options(args, &doc)?;
+    let opts = options(args, &doc, viewport)?;
     // The image's size and view are checked before its buffer is allocated.
     opts.check()?;
     let start = Instant::now();

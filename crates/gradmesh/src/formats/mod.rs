@@ -86,7 +86,7 @@ pub fn read_str_with_limits(
         Format::Off => off::read_off_with_limits(text, limits).map(single_layer),
         Format::Obj => obj::read_obj_with_limits(text, limits).map(single_layer),
         Format::Svg => svg::read_document_with_limits(text, crate::ColourSpace::Lab, limits)
-            .map(|(doc, _)| doc),
+            .map(|read| read.document),
     }
 }
 

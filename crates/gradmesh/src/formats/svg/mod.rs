@@ -50,6 +50,19 @@ pub fn read_svg(text: &str) -> Result<SvgScene, Error> {
     read_svg_with_limits(text, &Limits::DEFAULT)
 }
 
+/// An SVG file's mesh-gradient fills as a document, with the part of the plane the file shows.
+#[derive(Clone, Debug)]
+pub struct SvgDocument {
+    /// One layer per shape filled with a mesh gradient, bottom first.
+    pub document: Document,
+    /// What was left out, naming the element.
+    pub warnings: Vec<Warning>,
+    /// The rectangle of user space the picture shows ([`SvgScene::view_rect`]).
+    pub view: Option<kurbo::Rect>,
+    /// The picture's size in CSS pixels ([`SvgScene::pixel_size`]).
+    pub pixel_size: Option<(f64, f64)>,
+}
+
 /// Reads an SVG document and converts every mesh-gradient fill into a layer with colours in
 /// `space`, within `limits` (each layer is checked as any mesh read is). A file without any
 /// mesh-gradient fill is an error. The warnings name what was left out.
@@ -57,7 +70,7 @@ pub fn read_document_with_limits(
     text: &str,
     space: ColourSpace,
     limits: &Limits,
-) -> Result<(Document, Vec<Warning>), Error> {
+) -> Result<SvgDocument, Error> {
     let scene = read_svg_with_limits(text, limits)?;
     if scene.fills.is_empty() {
         return Err(ErrorKind::Invalid {
@@ -70,16 +83,18 @@ pub fn read_document_with_limits(
     for (i, mesh) in doc.layers.iter().enumerate() {
         limits.check_mesh(mesh).map_err(|e| e.in_layer(i))?;
     }
-    Ok((doc, warnings))
+    Ok(SvgDocument {
+        document: doc,
+        warnings,
+        view: scene.view_rect(),
+        pixel_size: scene.pixel_size(),
+    })
 }
 
 /// Reads an SVG file as [`read_document_with_limits`] does, in Lab; the layers are named after their
 /// gradients. A file larger than [`Limits::input_bytes`] is refused before it is read; every
 /// error is located in the file.
-pub fn read_path_with_limits(
-    path: &Path,
-    limits: &Limits,
-) -> Result<(Document, Vec<Warning>), Error> {
+pub fn read_path_with_limits(path: &Path, limits: &Limits) -> Result<SvgDocument, Error> {
     let text = super::read_text(path, limits.input_bytes).map_err(|e| e.in_file(path))?;
     read_document_with_limits(&text, ColourSpace::Lab, limits).map_err(|e| e.in_file(path))
 }

@@ -38,6 +38,16 @@ impl SvgScene {
             _ => None,
         })
     }
+
+    /// The picture's size in CSS pixels: the root's `width` and `height`, or else the view
+    /// box's size. `None` when the file gives neither.
+    pub fn pixel_size(&self) -> Option<(f64, f64)> {
+        match (self.width, self.height, self.view_box) {
+            (Some(w), Some(h), _) => Some((w, h)),
+            (_, _, Some(b)) => Some((b.width(), b.height())),
+            _ => None,
+        }
+    }
 }
 
 /// The rule that tells the inside of a shape's outline from the outside (`fill-rule`).
