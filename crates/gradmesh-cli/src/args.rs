@@ -289,7 +289,7 @@ pub struct RenderArgs {
     /// the surface's.
     #[arg(long, value_name = "DELTA_E", default_value_t = gradmesh::export::DEFAULT_TOLERANCE, help_heading = "Vector output")]
     pub tolerance: f64,
-    /// PDF: largest distance, in points, between the flat patches at the surface's irregular
+    /// PDF and SVG: largest distance, in points, between the flat patches at the surface's irregular
     /// spots and the surface.
     #[arg(long, value_name = "PT", default_value_t = gradmesh::export::DEFAULT_GEOMETRY_TOLERANCE_PX, help_heading = "Vector output")]
     pub geometry_tolerance: f64,
@@ -301,6 +301,10 @@ pub struct RenderArgs {
         help_heading = "Vector output"
     )]
     pub pdf_colour: PdfColourArg,
+    /// SVG: leave out the PNG of the picture beneath the mesh gradients (shown by viewers
+    /// without mesh gradients, such as browsers).
+    #[arg(long, help_heading = "Vector output")]
+    pub no_fallback: bool,
     /// Print the time each stage took, and the level drawn for each layer.
     #[arg(long)]
     pub timings: bool,

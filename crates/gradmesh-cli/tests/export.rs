@@ -97,3 +97,25 @@ fn bad_vector_options_are_errors_and_write_nothing() {
     let o = gradmesh(&["render", s(&input), "-o", s(&tiff)]);
     assert!(stderr(&o).contains("render writes .png"), "{}", stderr(&o));
 }
+
+#[test]
+fn an_svg_is_written_with_mesh_gradients_and_a_fallback() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = example("irregular-vertex.json");
+    let out = dir.path().join("out.svg");
+    let o = gradmesh(&["render", s(&input), "-o", s(&out), "--width", "96"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.contains("<meshgradient") && text.contains("data:image/png;base64,"));
+    let o = gradmesh(&[
+        "render",
+        s(&input),
+        "-o",
+        s(&out),
+        "--width",
+        "96",
+        "--no-fallback",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!std::fs::read_to_string(&out).unwrap().contains("<image"));
+}

@@ -59,6 +59,7 @@ fn options(args: &RenderArgs, doc: &Document) -> Result<RenderOptions, Error> {
 enum Output {
     Png,
     Pdf,
+    Svg,
 }
 
 fn output_kind(path: &std::path::Path) -> Option<Output> {
@@ -66,6 +67,7 @@ fn output_kind(path: &std::path::Path) -> Option<Output> {
     match ext.as_str() {
         "png" => Some(Output::Png),
         "pdf" => Some(Output::Pdf),
+        "svg" => Some(Output::Svg),
         _ => None,
     }
 }
@@ -74,7 +76,10 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     let Some(kind) = output_kind(&args.output) else {
         return Err(invalid(
             "output",
-            format!("{}: render writes .png or .pdf", args.output.display()),
+            format!(
+                "{}: render writes .png, .pdf or .svg",
+                args.output.display()
+            ),
         ));
     };
     let inputs: Vec<&std::path::Path> = args.inputs.iter().map(|p| p.as_path()).collect();
@@ -102,7 +107,8 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
 
     let opts = options(args, &doc)?;
     if kind != Output::Png {
-        return vector(args, &doc, &opts, &origins, read).map_err(locate);
+        let pdf = kind == Output::Pdf;
+        return vector(args, &doc, &opts, pdf, &origins, read).map_err(locate);
     }
     // The image's size and view are checked before its buffer is allocated.
     opts.check()?;
@@ -181,11 +187,12 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     Ok(())
 }
 
-/// Writes the document as a PDF, with the page and view of `render`.
+/// Writes the document as a PDF (`pdf`) or an SVG, with the page and view of `render`.
 fn vector(
     args: &RenderArgs,
     doc: &Document,
     render: &RenderOptions,
+    pdf: bool,
     origins: &[(&std::path::Path, usize)],
     read: std::time::Duration,
 ) -> Result<(), Error> {
@@ -195,7 +202,11 @@ fn vector(
     opts.colour = args.pdf_colour.into();
     opts.limits = args.limits.limits();
     let start = Instant::now();
-    let (bytes, info) = export::write_pdf(doc, &opts)?;
+    let (bytes, info) = if pdf {
+        export::write_pdf(doc, &opts)?
+    } else {
+        export::write_svg(doc, &opts, !args.no_fallback)?
+    };
     let made = start.elapsed();
     for w in &info.warnings {
         warn(w, origins);

@@ -34,6 +34,7 @@ mod bezier;
 mod pdf;
 mod split;
 mod surface;
+mod svg;
 
 use std::time::Instant;
 
@@ -49,6 +50,7 @@ use split::{OutPatch, Splitter, Target};
 use surface::{layer_surface, Curve, SurfaceOptions};
 
 pub use pdf::write_pdf;
+pub use svg::write_svg;
 
 /// The default colour tolerance, in ΔE00 ([`ExportOptions::tolerance`]).
 pub const DEFAULT_TOLERANCE: f64 = 0.5;
@@ -151,9 +153,18 @@ pub struct ExportInfo {
     pub warnings: Vec<Warning>,
 }
 
-/// One layer's output: its patches, outline and whether it needs a soft mask.
+/// The cells one Bézier patch was split into: `patches[first..first + n * m]`, row by row.
+pub(crate) struct SplitGrid {
+    pub first: usize,
+    pub n: usize,
+    pub m: usize,
+}
+
+/// One layer's output: its patches, how they were split, its outline and whether it needs a
+/// soft mask.
 pub(crate) struct LayerPatches {
     pub patches: Vec<OutPatch>,
+    pub grids: Vec<SplitGrid>,
     pub outline: Vec<Vec<Curve>>,
     pub masked: bool,
     pub approximated: usize,
@@ -192,11 +203,15 @@ pub(crate) fn layer_patches(
                 opacity: !surface.opaque,
             };
             let mut patches = Vec::new();
+            let mut grids = Vec::with_capacity(surface.nets.len());
             for net in &surface.nets {
-                splitter.split(net, &mut patches);
+                let first = patches.len();
+                let (n, m) = splitter.split(net, &mut patches);
+                grids.push(SplitGrid { first, n, m });
             }
             Ok(Some(LayerPatches {
                 patches,
+                grids,
                 outline: surface.outline,
                 masked: !surface.opaque,
                 approximated: surface.approximated,

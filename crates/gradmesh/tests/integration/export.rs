@@ -8,7 +8,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use gradmesh::export::{write_pdf, ExportOptions, PdfColour};
+use gradmesh::export::{write_pdf, write_svg, ExportInfo, ExportOptions, PdfColour};
 use gradmesh::formats;
 use gradmesh::render::{render_image, Image, RenderOptions};
 use gradmesh::{ColourSpace, Document, GradientMesh};
@@ -82,6 +82,8 @@ pub enum Tool {
     Mutool,
     Pdftoppm,
     Ghostscript,
+    /// For SVG.
+    Inkscape,
 }
 
 pub const TOOLS: [Tool; 3] = [Tool::Mutool, Tool::Pdftoppm, Tool::Ghostscript];
@@ -92,10 +94,12 @@ impl Tool {
             Tool::Mutool => ("mutool", "mupdf-tools"),
             Tool::Pdftoppm => ("pdftoppm", "poppler-utils"),
             Tool::Ghostscript => ("gs", "ghostscript"),
+            Tool::Inkscape => ("inkscape", "inkscape"),
         }
     }
 
-    /// Rasterises `pdf` at 72 dpi into a PNG beside it (with alpha where the tool gives it).
+    /// Rasterises `pdf` at 72 dpi (an SVG for Inkscape at 96, its pixel) into a PNG beside it
+    /// (with alpha where the tool gives it).
     fn rasterise(self, pdf: &Path) -> Raster {
         let (program, package) = self.program();
         let out = pdf.with_extension(format!("{program}.png"));
@@ -121,6 +125,10 @@ impl Tool {
                     "-dGraphicsAlphaBits=4",
                 ])
                 .arg(format!("-sOutputFile={}", out.display()))
+                .arg(pdf),
+            Tool::Inkscape => cmd
+                .args(["--export-type=png", "--export-dpi=96"])
+                .arg(format!("--export-filename={}", out.display()))
                 .arg(pdf),
         };
         let status = cmd.output().unwrap_or_else(|e| {
@@ -247,18 +255,36 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// Exports `doc` with `opts`, rasterises it with every tool and compares each with gradmesh's
-/// render. Returns the comparisons and the PDF's size.
+/// Exports `doc` with `opts` as a PDF, rasterises it with every PDF renderer and compares
+/// each with gradmesh's render. Returns the comparisons and the PDF's size.
 pub fn check_document(
     doc: &Document,
     opts: &ExportOptions,
     name: &str,
 ) -> (Vec<(Tool, Comparison)>, usize) {
     let (pdf, info) = write_pdf(doc, opts).unwrap();
+    check_file(doc, opts, name, "pdf", (pdf, info), &TOOLS)
+}
+
+/// As [`check_document`], for an SVG (without its PNG fallback) drawn by Inkscape.
+pub fn check_svg(doc: &Document, opts: &ExportOptions, name: &str) -> (Comparison, usize) {
+    let written = write_svg(doc, opts, false).unwrap();
+    let (results, bytes) = check_file(doc, opts, name, "svg", written, &[Tool::Inkscape]);
+    (results[0].1, bytes)
+}
+
+fn check_file(
+    doc: &Document,
+    opts: &ExportOptions,
+    name: &str,
+    extension: &str,
+    (bytes, info): (Vec<u8>, ExportInfo),
+    tools: &[Tool],
+) -> (Vec<(Tool, Comparison)>, usize) {
     assert!(info.patches > 0);
     let dir = scratch(name);
-    let path = dir.join(format!("{name}.pdf"));
-    std::fs::write(&path, &pdf).unwrap();
+    let path = dir.join(format!("{name}.{extension}"));
+    std::fs::write(&path, &bytes).unwrap();
     let mut render = RenderOptions::new(opts.width, opts.height, opts.view);
     render.dither = false;
     let (alpha, _) = render_image(doc, &render).unwrap();
@@ -272,7 +298,7 @@ pub fn check_document(
     let (ours_white, ours_alpha) = (Raster::from_image(&white), Raster::from_image(&alpha));
     render.background = None;
     let inside = interior(doc, &render);
-    let comparisons = TOOLS
+    let comparisons = tools
         .iter()
         .map(|&tool| {
             (
@@ -290,7 +316,7 @@ pub fn check_document(
     if std::env::var_os("GRADMESH_KEEP_EXPORTS").is_none() {
         std::fs::remove_dir_all(&dir).ok();
     }
-    (comparisons, pdf.len())
+    (comparisons, bytes.len())
 }
 
 fn example(name: &str) -> Document {
@@ -335,7 +361,7 @@ fn assert_close(name: &str, results: &[(Tool, Comparison)], bar: impl Fn(Tool) -
 fn mask_bar(tool: Tool) -> (f64, f64) {
     match tool {
         Tool::Pdftoppm => (5.0, 40.0),
-        Tool::Mutool | Tool::Ghostscript => (1.0, 3.0),
+        Tool::Mutool | Tool::Ghostscript | Tool::Inkscape => (1.0, 3.0),
     }
 }
 
@@ -344,7 +370,7 @@ fn mask_bar(tool: Tool) -> (f64, f64) {
 fn lab_bar(tool: Tool) -> (f64, f64) {
     match tool {
         Tool::Pdftoppm => (1.0, 3.0),
-        Tool::Mutool | Tool::Ghostscript => (6.0, 12.0),
+        Tool::Mutool | Tool::Ghostscript | Tool::Inkscape => (6.0, 12.0),
     }
 }
 
@@ -481,5 +507,105 @@ fn tucan_matches_the_render_in_every_pdf_renderer() {
             PdfColour::Srgb => assert_close(name, results, strict),
             PdfColour::Lab => assert_close(name, results, lab_bar),
         }
+    }
+}
+
+#[test]
+fn svg_mesh_gradients_match_the_render_in_inkscape() {
+    for name in ["irregular-vertex.json", "edge-kinds.json"] {
+        let doc = example(name);
+        let render = RenderOptions::fit(&doc, 256);
+        let opts = ExportOptions::new(render.width, render.height, render.view);
+        let (c, bytes) = check_svg(
+            &doc,
+            &opts,
+            &format!("{}-svg", name.trim_end_matches(".json")),
+        );
+        assert_close(
+            &format!("{name} SVG ({bytes} bytes)"),
+            &[(Tool::Inkscape, c)],
+            examples_bar,
+        );
+    }
+}
+
+#[test]
+fn svg_fallback_is_a_png_beneath_the_meshes() {
+    let doc = example("irregular-vertex.json");
+    let render = RenderOptions::fit(&doc, 64);
+    let opts = ExportOptions::new(render.width, render.height, render.view);
+    let (with, _) = write_svg(&doc, &opts, true).unwrap();
+    let (without, _) = write_svg(&doc, &opts, false).unwrap();
+    let (with, without) = (
+        String::from_utf8(with).unwrap(),
+        String::from_utf8(without).unwrap(),
+    );
+    let image = with
+        .find("data:image/png;base64,")
+        .expect("an embedded PNG");
+    assert!(image < with.find("<meshgradient").unwrap());
+    assert!(with.contains(r#"fill="url(#mesh0) none""#));
+    assert!(!without.contains("<image"));
+}
+
+/// The figures of docs/export.md for the real artwork: patches, bytes and time, and each
+/// renderer's ΔE00 against the render, at 512 pixels wide. Run with `--ignored --nocapture`.
+#[test]
+#[ignore]
+fn real_artwork_figures() {
+    let artwork: [(&str, Vec<String>); 3] = [
+        (
+            "Tucan",
+            (0..=5)
+                .rev()
+                .map(|k| format!("Tucan_Tucan_Layer{k}.off"))
+                .collect(),
+        ),
+        (
+            "Paprika",
+            (0..=2)
+                .rev()
+                .map(|k| format!("Paprika_Paprika_layer{k}.off"))
+                .collect(),
+        ),
+        ("Glasses", vec!["Glasses.off".to_string()]),
+    ];
+    for (name, files) in &artwork {
+        let mut doc = Document::default();
+        for f in files {
+            doc.layers.extend(
+                formats::read_path(&super::realdata::path(f))
+                    .unwrap()
+                    .layers,
+            );
+        }
+        let render = RenderOptions::fit(&doc, 512);
+        for colour in [PdfColour::Lab, PdfColour::Srgb] {
+            let mut opts = ExportOptions::new(render.width, render.height, render.view);
+            opts.colour = colour;
+            let (_, info) = write_pdf(&doc, &opts).unwrap();
+            let (results, bytes) =
+                check_document(&doc, &opts, &format!("{name}-{}", colour.name()));
+            eprintln!(
+                "{name} PDF {}: {}x{}, {} patches, {bytes} bytes, {:.0} ms",
+                colour.name(),
+                render.width,
+                render.height,
+                info.patches,
+                info.seconds * 1e3
+            );
+            for (tool, c) in results {
+                eprintln!(
+                    "  {tool:?}: mean {:.2}, 99th {:.2}, outline {:?}",
+                    c.mean, c.p99, c.outline_px
+                );
+            }
+        }
+        let opts = ExportOptions::new(render.width, render.height, render.view);
+        let (c, bytes) = check_svg(&doc, &opts, &format!("{name}-svg"));
+        eprintln!(
+            "{name} SVG: {bytes} bytes; Inkscape: mean {:.2}, 99th {:.2}, outline {:?}",
+            c.mean, c.p99, c.outline_px
+        );
     }
 }
