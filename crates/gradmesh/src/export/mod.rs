@@ -96,7 +96,8 @@ pub struct ExportOptions {
     pub geometry_tolerance_px: f64,
     /// The colour space of a PDF's shadings (SVG is always sRGB).
     pub colour: PdfColour,
-    /// Limits on the input and its refinement.
+    /// Limits on the input and its refinement; [`Limits::refined_faces`] also caps the patches
+    /// of a layer.
     pub limits: Limits,
 }
 
@@ -208,6 +209,16 @@ pub(crate) fn layer_patches(
                 let first = patches.len();
                 let (n, m) = splitter.split(net, &mut patches);
                 grids.push(SplitGrid { first, n, m });
+                // The patches count against the refinement's face limit: a runaway split
+                // stops before it holds much more memory than a refinement may.
+                if patches.len() as u64 > opts.limits.refined_faces {
+                    return Err(Error::new(ErrorKind::LimitExceeded {
+                        what: "the exported patch count".into(),
+                        found: patches.len() as u64,
+                        limit: opts.limits.refined_faces,
+                    })
+                    .in_layer(index));
+                }
             }
             Ok(Some(LayerPatches {
                 patches,

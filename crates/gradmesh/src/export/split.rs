@@ -9,7 +9,8 @@
 //! units). That bound starts the counts (it is about twice the real error); the counts then
 //! grow until the CIEDE2000 difference between the bilinear colour, in the viewer's space, and
 //! the surface's colour is within the tolerance at nine points of every cell (centre, side
-//! midpoints, quarter points) and opacity within a hundredth of it.
+//! midpoints, quarter points) and opacity within a hundredth of it. Colours are compared after
+//! the renderer's gamut mapping, which is what is written.
 
 use palette::color_difference::Ciede2000;
 use palette::{white_point::D65, Lab};

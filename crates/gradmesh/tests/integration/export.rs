@@ -482,6 +482,11 @@ fn bad_options_are_errors_naming_them() {
     opts.width = 256;
     opts.geometry_tolerance_px = f64::NAN;
     assert!(write_pdf(&doc, &opts).is_err());
+    opts.geometry_tolerance_px = 0.1;
+    // Above the 180 faces of level 2, below the 1,325 patches.
+    opts.limits.refined_faces = 200;
+    let e = write_pdf(&doc, &opts).unwrap_err();
+    assert!(e.to_string().contains("exported patch count"), "{e}");
 }
 
 #[test]
