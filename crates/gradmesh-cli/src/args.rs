@@ -131,6 +131,24 @@ impl From<ColourSpaceArg> for gradmesh::ColourSpace {
     }
 }
 
+/// `--pdf-colour`.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum PdfColourArg {
+    /// CIE Lab with the D65 white point.
+    Lab,
+    /// sRGB (DeviceRGB), split finer so that RGB interpolation stays within the tolerance.
+    Srgb,
+}
+
+impl From<PdfColourArg> for gradmesh::export::PdfColour {
+    fn from(c: PdfColourArg) -> Self {
+        match c {
+            PdfColourArg::Lab => gradmesh::export::PdfColour::Lab,
+            PdfColourArg::Srgb => gradmesh::export::PdfColour::Srgb,
+        }
+    }
+}
+
 /// `--gamut`.
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum GamutArg {
@@ -226,7 +244,8 @@ pub struct RenderArgs {
     /// Input files (.json, .off, .obj, .svg), drawn in order: the first at the bottom.
     #[arg(required = true)]
     pub inputs: Vec<PathBuf>,
-    /// Output file (.png).
+    /// Output file: .png (pixels), .pdf (tensor-product patch shadings) or .svg (mesh
+    /// gradients over a PNG fallback).
     #[arg(short, long)]
     pub output: PathBuf,
     /// Image width in pixels (with only --height, derived from the view's aspect ratio).
@@ -267,6 +286,26 @@ pub struct RenderArgs {
     /// Refine to this level instead of choosing one from the image size.
     #[arg(long)]
     pub level: Option<usize>,
+    /// PDF and SVG: largest colour difference (ΔE00) between a viewer's bilinear colour and
+    /// the surface's.
+    #[arg(long, value_name = "DELTA_E", default_value_t = gradmesh::export::DEFAULT_TOLERANCE, help_heading = "Vector output")]
+    pub tolerance: f64,
+    /// PDF and SVG: largest distance, in points, between the flat patches at the surface's irregular
+    /// spots and the surface.
+    #[arg(long, value_name = "PT", default_value_t = gradmesh::export::DEFAULT_GEOMETRY_TOLERANCE_PX, help_heading = "Vector output")]
+    pub geometry_tolerance: f64,
+    /// PDF: the shadings' colour space (Lab, or sRGB for viewers that interpolate in RGB).
+    #[arg(
+        long,
+        value_name = "SPACE",
+        default_value = "lab",
+        help_heading = "Vector output"
+    )]
+    pub pdf_colour: PdfColourArg,
+    /// SVG: leave out the PNG of the picture beneath the mesh gradients (shown by viewers
+    /// without mesh gradients, such as browsers).
+    #[arg(long, help_heading = "Vector output")]
+    pub no_fallback: bool,
     /// Print the time each stage took, and the level drawn for each layer.
     #[arg(long)]
     pub timings: bool,

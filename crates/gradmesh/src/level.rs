@@ -20,6 +20,20 @@ pub struct Level {
 }
 
 impl Level {
+    /// Whether semi-sharpness still touches the boundary: the outline is only a uniform
+    /// B-spline of the boundary vertices once it has decayed there.
+    pub(crate) fn semi_sharp_on_boundary(&self) -> bool {
+        let t = &self.topology;
+        let semi = |s: f64| rules::is_sharp(s) && !rules::is_infinite(s);
+        (0..t.vertex_count()).any(|v| {
+            t.is_boundary_vertex(v)
+                && (semi(self.vertex_sharpness[v])
+                    || t.vertex_edges(v)
+                        .iter()
+                        .any(|&e| semi(self.edge_sharpness[e as usize])))
+        })
+    }
+
     /// A level with the boundary rules applied: boundary edges infinitely sharp and, under
     /// [`BoundaryInterpolation::EdgeAndCorner`], boundary vertices with a single face made
     /// corners (as OpenSubdiv does to its base level).

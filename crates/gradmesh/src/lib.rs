@@ -39,6 +39,7 @@ mod colour;
 mod edit_check;
 mod edits;
 mod error;
+pub mod export;
 mod folds;
 pub mod formats;
 mod level;

@@ -1,7 +1,8 @@
-//! `gradmesh render`: the limit surface of every layer, to a PNG.
+//! `gradmesh render`: the limit surface of every layer, to a PNG, a PDF or an SVG.
 
 use std::time::Instant;
 
+use gradmesh::export::{self, ExportOptions};
 use gradmesh::formats;
 use gradmesh::parse_css_colour;
 use gradmesh::render::{self, PngDepth, RenderOptions, View};
@@ -63,18 +64,34 @@ fn options(
     Ok(opts)
 }
 
+/// What the output's extension asks for.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Output {
+    Png,
+    Pdf,
+    Svg,
+}
+
+fn output_kind(path: &std::path::Path) -> Option<Output> {
+    let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+    match ext.as_str() {
+        "png" => Some(Output::Png),
+        "pdf" => Some(Output::Pdf),
+        "svg" => Some(Output::Svg),
+        _ => None,
+    }
+}
+
 pub fn run(args: &RenderArgs) -> Result<(), Error> {
-    if formats::Format::from_path(&args.output).is_some()
-        || args
-            .output
-            .extension()
-            .is_none_or(|e| !e.eq_ignore_ascii_case("png"))
-    {
+    let Some(kind) = output_kind(&args.output) else {
         return Err(invalid(
             "output",
-            format!("{}: render writes .png", args.output.display()),
+            format!(
+                "{}: render writes .png, .pdf or .svg",
+                args.output.display()
+            ),
         ));
-    }
+    };
     let inputs: Vec<&std::path::Path> = args.inputs.iter().map(|p| p.as_path()).collect();
     super::check_not_input(&args.output, &inputs, args.force)?;
 
@@ -104,6 +121,10 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     };
 
     let opts = options(args, &doc, viewport)?;
+    if kind != Output::Png {
+        let pdf = kind == Output::Pdf;
+        return vector(args, &doc, &opts, pdf, &origins, read).map_err(locate);
+    }
     // The image's size and view are checked before its buffer is allocated.
     opts.check()?;
     let start = Instant::now();
@@ -125,14 +146,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     };
     let rendered = start.elapsed();
     for w in &info.warnings {
-        match w.layer.and_then(|l| origins.get(l)) {
-            Some(&(path, i)) => eprintln!(
-                "gradmesh: warning: {}: layer {i}: {}",
-                path.display(),
-                w.message
-            ),
-            None => eprintln!("gradmesh: warning: {w}"),
-        }
+        warn(w, &origins);
     }
 
     // Encoded straight into a temporary file (the PNG is never held in memory), which is
@@ -186,6 +200,64 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         }
     }
     Ok(())
+}
+
+/// Writes the document as a PDF (`pdf`) or an SVG, with the page and view of `render`.
+fn vector(
+    args: &RenderArgs,
+    doc: &Document,
+    render: &RenderOptions,
+    pdf: bool,
+    origins: &[(&std::path::Path, usize)],
+    read: std::time::Duration,
+) -> Result<(), Error> {
+    let mut opts = ExportOptions::new(render.width, render.height, render.view);
+    opts.tolerance = args.tolerance;
+    opts.geometry_tolerance_px = args.geometry_tolerance;
+    opts.colour = args.pdf_colour.into();
+    opts.limits = args.limits.limits();
+    let start = Instant::now();
+    let (bytes, info) = if pdf {
+        export::write_pdf(doc, &opts)?
+    } else {
+        export::write_svg(doc, &opts, !args.no_fallback)?
+    };
+    let made = start.elapsed();
+    for w in &info.warnings {
+        warn(w, origins);
+    }
+    let start = Instant::now();
+    formats::write_atomic(&args.output, &bytes)?;
+    if args.timings {
+        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+        eprintln!("read       {:9.2} ms", ms(read));
+        eprintln!(
+            "export     {:9.2} ms ({}x{} pt, {} patches, {} bytes)",
+            ms(made),
+            opts.width,
+            opts.height,
+            info.patches,
+            bytes.len()
+        );
+        eprintln!("write      {:9.2} ms", ms(start.elapsed()));
+        eprintln!(
+            "flat patches at irregular spots: {}, largest distance {:.4} pt",
+            info.approximated, info.geometry_error_px
+        );
+    }
+    Ok(())
+}
+
+/// Prints warning `w`, naming the file and layer its layer came from (`origins`).
+fn warn(w: &gradmesh::Warning, origins: &[(&std::path::Path, usize)]) {
+    match w.layer.and_then(|l| origins.get(l)) {
+        Some(&(path, i)) => eprintln!(
+            "gradmesh: warning: {}: layer {i}: {}",
+            path.display(),
+            w.message
+        ),
+        None => eprintln!("gradmesh: warning: {w}"),
+    }
 }
 
 /// The rendered picture, in the type it was drawn in.

@@ -781,6 +781,75 @@ impl LocalPatch {
         }
         Some(grid)
     }
+
+    /// The limit surface over face `root` down to `depth`, as pieces: the control grids of the
+    /// descendants set aside as B-spline patches at every depth (exact), and the descendants
+    /// still irregular at `depth` as the places of their corners 0, 1, 2, 3 in the face's grid of
+    /// `2^depth` cells a side (the samples of [`LocalPatch::grid`] there, or at twice those
+    /// coordinates in a grid twice as fine). `None` if the shape cannot be refined that far.
+    pub fn pieces(&mut self, root: usize, depth: usize) -> Option<Pieces> {
+        self.reach(depth)?;
+        let root = root as u32;
+        let mut pieces = Pieces::default();
+        for (at, rows) in self.depths.iter().zip(&self.rows).take(depth + 1) {
+            for (tile, points) in at.patches.iter().filter(|(tile, _)| tile.root == root) {
+                let cp = control_grid(points, |r| rows[r as usize]);
+                // Turned back to the face's own orientation: `u` along the face's grid's x.
+                pieces.patches.push(oriented(cp, tile));
+            }
+        }
+        if let Some(at) = self.depths.get(depth) {
+            for tile in at.tiles.iter().filter(|tile| tile.root == root) {
+                let o = tile.origin;
+                pieces.irregular.push([
+                    o,
+                    [o[0] + tile.u[0], o[1] + tile.u[1]],
+                    [o[0] + tile.u[0] + tile.v[0], o[1] + tile.u[1] + tile.v[1]],
+                    [o[0] + tile.v[0], o[1] + tile.v[1]],
+                ]);
+            }
+        }
+        Some(pieces)
+    }
+}
+
+/// What [`LocalPatch::pieces`] gives: exact patches, and the corners of the irregular rest.
+#[derive(Default)]
+pub(crate) struct Pieces {
+    /// Control grids of the descendants whose limit surface is a B-spline patch.
+    pub patches: Vec<ControlGrid>,
+    /// The descendants still irregular, as their corners' places in the face's grid.
+    pub irregular: Vec<[[i64; 2]; 4]>,
+}
+
+/// The control grid `cp` of `tile` with its parameters turned so that `u` runs along the root
+/// face's `u` and `v` along its `v`: tiles of a locally refined face are rotated or mirrored
+/// against it, and a surface's orientation decides which sheet shows where it folds.
+fn oriented(cp: ControlGrid, tile: &Tile) -> ControlGrid {
+    let (u, v) = (tile.u, tile.v);
+    // Each of the tile's steps is a unit step of the root's grid: x (`[1, 0]`) or y, either way.
+    let along_x = u[0] != 0;
+    let mut out = cp;
+    for j in 0..4 {
+        for i in 0..4 {
+            // The root's (x, y) place of the tile's control point (i, j), within 0..4.
+            let (x, y) = if along_x {
+                (flip(i, u[0] < 0), flip(j, v[1] < 0))
+            } else {
+                (flip(j, v[0] < 0), flip(i, u[1] < 0))
+            };
+            out[y][x] = cp[j][i];
+        }
+    }
+    out
+}
+
+fn flip(k: usize, reversed: bool) -> usize {
+    if reversed {
+        3 - k
+    } else {
+        k
+    }
 }
 
 #[cfg(test)]

@@ -27,9 +27,8 @@ use std::sync::Arc;
 use rayon::prelude::*;
 
 use crate::colour::ColourSpace;
-use crate::level::Level;
+
 use crate::refine::{RefinedData, Refinement};
-use crate::rules;
 use crate::topology::Topology;
 use crate::validate::VertexData;
 
@@ -110,20 +109,6 @@ pub(super) struct Tessellation {
     pub bounds: Option<Bounds>,
     /// Faces whose plans were taken from the [`TessellationCache`].
     pub reused_plans: usize,
-}
-
-/// Whether semi-sharpness still touches the boundary at `level`: the outline is only a uniform
-/// B-spline of the boundary vertices once it has decayed there.
-fn semi_sharp_on_boundary(level: &Level) -> bool {
-    let t = &level.topology;
-    let semi = |s: f64| rules::is_sharp(s) && !rules::is_infinite(s);
-    (0..t.vertex_count()).any(|v| {
-        t.is_boundary_vertex(v)
-            && (semi(level.vertex_sharpness[v])
-                || t.vertex_edges(v)
-                    .iter()
-                    .any(|&e| semi(level.edge_sharpness[e as usize])))
-    })
 }
 
 /// The plans of a layer's faces at its last preparation, kept by a
@@ -368,7 +353,7 @@ fn build_base_level(
     let mut k0 = base_level(refinement, pixels).max(refinement.base().edits.deepest_level() + 1);
     loop {
         build_levels_to(refinement, data, k0);
-        if !semi_sharp_on_boundary(refinement.level(k0)) {
+        if !refinement.level(k0).semi_sharp_on_boundary() {
             return Some(k0);
         }
         if k0 >= DEEPEST_BASE_LEVEL {

@@ -95,19 +95,19 @@ mod cache;
 mod composite;
 mod coverage;
 mod face_plans;
-mod gamut;
+pub(crate) mod gamut;
 mod info;
 mod layer;
 mod measure;
 mod nearest;
 mod options;
-mod outline;
+pub(crate) mod outline;
 mod output;
 mod overlay;
 mod quadratic;
 mod stitch;
 mod triangles;
-mod view;
+pub(crate) mod view;
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
 mod wide_vectors;

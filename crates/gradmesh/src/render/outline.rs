@@ -112,6 +112,55 @@ fn flatten_segment(q: [[f64; 2]; 4], tolerance: f64, out: &mut Vec<Line>) {
     }
 }
 
+/// Calls `segment(q)` with the four B-spline control points of each cubic segment of the
+/// boundary loop `lp` of `level` (whose control positions are `pos(i)` for loop index `i`, taken
+/// modulo the loop's length), in order along the loop. Closed loops are periodic B-splines;
+/// loops with corners are open spans from corner to corner with phantom points at both ends.
+pub(crate) fn for_each_boundary_segment(
+    level: &Level,
+    lp: &[u32],
+    pos: impl Fn(usize) -> [f64; 2],
+    mut segment: impl FnMut([[f64; 2]; 4]),
+) {
+    let m = lp.len();
+    if m < 2 {
+        return;
+    }
+    let corners: Vec<usize> = (0..m)
+        .filter(|&i| level.vertex_rule(lp[i] as usize) == VertexRule::Corner)
+        .collect();
+    if corners.is_empty() {
+        // A closed periodic B-spline.
+        for i in 0..m {
+            segment([pos(i + m - 1), pos(i), pos(i + 1), pos(i + 2)]);
+        }
+        return;
+    }
+    // Open spans from corner to corner, with phantom points at both ends.
+    for (c, &start) in corners.iter().enumerate() {
+        let end = if c + 1 < corners.len() {
+            corners[c + 1]
+        } else {
+            corners[0] + m
+        };
+        let span: Vec<[f64; 2]> = (start..=end).map(&pos).collect();
+        let n = span.len() - 1;
+        let phantom = |a: [f64; 2], b: [f64; 2]| [2.0 * a[0] - b[0], 2.0 * a[1] - b[1]];
+        let at = |i: isize| -> [f64; 2] {
+            if i < 0 {
+                phantom(span[0], span[1])
+            } else if i as usize > n {
+                phantom(span[n], span[n - 1])
+            } else {
+                span[i as usize]
+            }
+        };
+        for i in 0..n as isize {
+            segment([at(i - 1), at(i), at(i + 1), at(i + 2)]);
+        }
+    }
+}
+
 /// The flattened outline of `level`, whose control positions in pixels are `px`.
 pub(crate) fn outline(
     level: &Level,
@@ -122,48 +171,10 @@ pub(crate) fn outline(
     let mut lines = Vec::new();
     for lp in loops {
         let m = lp.len();
-        if m < 2 {
-            continue;
-        }
         let pos = |i: usize| snap(px[lp[i % m] as usize]);
-        let corners: Vec<usize> = (0..m)
-            .filter(|&i| level.vertex_rule(lp[i] as usize) == VertexRule::Corner)
-            .collect();
-        if corners.is_empty() {
-            // A closed periodic B-spline.
-            for i in 0..m {
-                let q = [pos(i + m - 1), pos(i), pos(i + 1), pos(i + 2)];
-                flatten_segment(q, tolerance, &mut lines);
-            }
-            continue;
-        }
-        // Open spans from corner to corner, with phantom points at both ends.
-        for (c, &start) in corners.iter().enumerate() {
-            let end = if c + 1 < corners.len() {
-                corners[c + 1]
-            } else {
-                corners[0] + m
-            };
-            let span: Vec<[f64; 2]> = (start..=end).map(pos).collect();
-            let n = span.len() - 1;
-            let phantom = |a: [f64; 2], b: [f64; 2]| [2.0 * a[0] - b[0], 2.0 * a[1] - b[1]];
-            let at = |i: isize| -> [f64; 2] {
-                if i < 0 {
-                    phantom(span[0], span[1])
-                } else if i as usize > n {
-                    phantom(span[n], span[n - 1])
-                } else {
-                    span[i as usize]
-                }
-            };
-            for i in 0..n as isize {
-                flatten_segment(
-                    [at(i - 1), at(i), at(i + 1), at(i + 2)],
-                    tolerance,
-                    &mut lines,
-                );
-            }
-        }
+        for_each_boundary_segment(level, lp, pos, |q| {
+            flatten_segment(q, tolerance, &mut lines)
+        });
     }
     cancel_opposite(lines)
 }

@@ -21,6 +21,7 @@ mod declared_counts;
 mod degenerate;
 mod edits;
 mod errors_doc;
+mod export;
 mod formats;
 mod fuzz_replay;
 mod opensubdiv_oracle;
