@@ -1,0 +1,227 @@
+//! What the page asks for and what it gets back: commands in, state and frames out. The
+//! WebSocket and the HTTP API both go through [`Session::handle`].
+
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use gradmesh::render::View;
+use serde::Deserialize;
+
+use crate::editor::Editor;
+use crate::ops::Op;
+use crate::security::Folder;
+use crate::state::Status;
+use crate::viewer::{Viewer, Viewport};
+
+/// The server's shared state: the document being edited and the folder it lives in.
+#[derive(Debug)]
+pub struct App {
+    /// The document.
+    pub editor: Mutex<Editor>,
+    /// The starting folder.
+    pub folder: Folder,
+}
+
+impl App {
+    /// The editor, even if a thread panicked while holding it (its data is whole: every edit
+    /// replaces the picture in one assignment).
+    pub fn editor(&self) -> MutexGuard<'_, Editor> {
+        self.editor.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+/// One request of the page.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Command {
+    /// An edit, part of a gesture if `gesture` is given.
+    Edit {
+        /// The edit.
+        op: Op,
+        /// The gesture it belongs to.
+        #[serde(default)]
+        gesture: Option<u64>,
+    },
+    /// Asks for the state (and a frame), changing nothing.
+    State,
+    /// Ends the open gesture.
+    EndGesture,
+    /// Undoes one step.
+    Undo,
+    /// Redoes one step.
+    Redo,
+    /// Sets the canvas size (device pixels) and the rectangle of the plane it shows.
+    View {
+        /// Width in pixels.
+        width: u32,
+        /// Height in pixels.
+        height: u32,
+        /// Left, top, right, bottom.
+        view: [f64; 4],
+    },
+    /// Saves to the document's file.
+    Save,
+    /// Saves to another JSON file in the starting folder.
+    SaveAs {
+        /// Its name relative to the folder.
+        name: String,
+    },
+    /// Opens a document of the starting folder.
+    Open {
+        /// Its name relative to the folder.
+        name: String,
+    },
+    /// Starts a new document.
+    New,
+}
+
+/// A message for the page.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Outgoing {
+    /// JSON: the state.
+    Text(String),
+    /// JSON: an error message.
+    Error(String),
+    /// A frame (see [`crate::viewer::encode_frame`]).
+    Binary(Vec<u8>),
+    /// The end of the answer to a batch of commands: the page may send the next batch.
+    Done,
+}
+
+/// One page's session: its viewer and what it was last told.
+pub struct Session {
+    app: Arc<App>,
+    viewer: Viewer,
+    /// The history version the page last got the state of.
+    told_version: Option<(u64, bool)>,
+}
+
+impl Session {
+    /// A session of `app`.
+    pub fn new(app: Arc<App>) -> Session {
+        Session {
+            app,
+            viewer: Viewer::new(),
+            told_version: None,
+        }
+    }
+
+    /// The viewer (its last frame).
+    pub fn viewer(&self) -> &Viewer {
+        &self.viewer
+    }
+
+    /// Handles a batch of JSON commands: all of them in order, then one frame and one state
+    /// for the result. Messages that are not commands get an error message each.
+    pub fn handle_texts(&mut self, texts: &[String]) -> Vec<Outgoing> {
+        let mut out = Vec::new();
+        let mut commands = Vec::with_capacity(texts.len());
+        for text in texts {
+            match serde_json::from_str::<Command>(text) {
+                Ok(c) => commands.push(c),
+                Err(e) => out.push(error_message(&format!("malformed command: {e}"))),
+            }
+        }
+        out.extend(self.handle(&commands));
+        out
+    }
+
+    /// Handles commands in order, then renders once; returns the errors, the state if it
+    /// changed, and the frame if pixels changed.
+    pub fn handle(&mut self, commands: &[Command]) -> Vec<Outgoing> {
+        let mut out = Vec::new();
+        for command in commands {
+            if let Err(message) = self.run(command) {
+                out.push(error_message(&message));
+            }
+        }
+        let (doc, version, gesture_open, status) = {
+            let editor = self.app.editor();
+            let h = &editor.history;
+            let gesture_open = h.gesture_open();
+            let key = (h.version(), gesture_open);
+            let status = (self.told_version != Some(key)).then(|| {
+                let (can_undo, can_redo) = h.can_undo_redo();
+                Status {
+                    picture: h.current(),
+                    file: editor.path.as_deref().map(|p| self.app.folder.name_of(p)),
+                    modified: h.modified(),
+                    can_undo,
+                    can_redo,
+                    with_folds: !gesture_open,
+                }
+                .to_json()
+                .to_string()
+            });
+            (h.current().visible(), key.0, gesture_open, status)
+        };
+        match self.viewer.render(&doc) {
+            Ok(Some(frame)) => out.push(Outgoing::Binary(frame)),
+            Ok(None) => {}
+            Err(e) => out.push(error_message(&format!("cannot render: {e}"))),
+        }
+        if let Some(status) = status {
+            self.told_version = Some((version, gesture_open));
+            out.push(Outgoing::Text(status));
+        }
+        out.push(Outgoing::Done);
+        out
+    }
+
+    /// Runs one command.
+    fn run(&mut self, command: &Command) -> Result<(), String> {
+        let app = Arc::clone(&self.app);
+        let mut editor = app.editor();
+        match command {
+            Command::Edit { op, gesture } => editor.history.apply(op, *gesture),
+            Command::State => Ok(()),
+            Command::EndGesture => {
+                editor.history.end_gesture();
+                Ok(())
+            }
+            Command::Undo => {
+                editor.history.undo();
+                Ok(())
+            }
+            Command::Redo => {
+                editor.history.redo();
+                Ok(())
+            }
+            Command::View {
+                width,
+                height,
+                view,
+            } => {
+                let [x0, y0, x1, y1] = *view;
+                self.viewer.set_viewport(Viewport {
+                    width: *width,
+                    height: *height,
+                    view: View::new(x0, y0, x1, y1),
+                })
+            }
+            Command::Save => match editor.path.clone() {
+                Some(path) => editor.save_to(&path),
+                None => Err("this document has no file yet: use Save as".into()),
+            },
+            Command::SaveAs { name } => {
+                let path = app.folder.resolve(name)?;
+                editor.save_to(&path)
+            }
+            Command::Open { name } => {
+                let path = app.folder.resolve(name)?;
+                *editor = Editor::open(&path)?;
+                self.told_version = None;
+                Ok(())
+            }
+            Command::New => {
+                *editor = Editor::new_document();
+                self.told_version = None;
+                Ok(())
+            }
+        }
+    }
+}
+
+/// An error message for the page.
+pub fn error_message(message: &str) -> Outgoing {
+    Outgoing::Error(serde_json::json!({"type": "error", "message": message}).to_string())
+}
