@@ -589,7 +589,10 @@ $("colour-picker").addEventListener("change", () => {
   if (colourGesture !== null) send({ type: "end_gesture" });
   colourGesture = null;
 });
-$("colour-hex").addEventListener("change", (event) => setColour({ css: event.target.value.trim() }));
+$("colour-hex").addEventListener("change", (event) => {
+  const text = event.target.value.trim();
+  if (text) setColour({ css: text });
+});
 for (const id of ["c0", "c1", "c2"]) {
   $(id).addEventListener("change", () => setColour({ colour: ["c0", "c1", "c2"].map((c) => Number($(c).value)) }));
 }

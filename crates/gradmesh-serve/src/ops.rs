@@ -402,7 +402,8 @@ fn set_colour(
     let (colour, text) = match (colour, css) {
         (Some(c), None) => (c, None),
         (None, Some(text)) => {
-            let (c, _alpha) = parse_css_colour(text, mesh.colour_space)?;
+            let (c, _alpha) = parse_css_colour(text, mesh.colour_space)
+                .map_err(|e| format!("{text:?} is not a colour: {e}"))?;
             (c, Some(text.to_string()))
         }
         _ => return Err("give either a colour's coordinates or a CSS colour".into()),
