@@ -296,6 +296,17 @@ function drawOverlay() {
       c.beginPath(); c.arc(sx, sy, r + 4, 0, 2 * Math.PI); c.stroke();
     }
   });
+  for (const [p, f, hex] of layer.sides) {
+    // A dot inside the face, near the point: the colour of that side.
+    const corners = layer.faces[f];
+    if (!corners) continue;
+    const centre = corners.reduce((acc, q) => [acc[0] + layer.points[q][0] / corners.length,
+      acc[1] + layer.points[q][1] / corners.length], [0, 0]);
+    const [x, y] = layer.points[p];
+    const [sx, sy] = toScreen(x + 0.2 * (centre[0] - x), y + 0.2 * (centre[1] - y));
+    c.fillStyle = hex; c.strokeStyle = "#000"; c.lineWidth = 1.5;
+    c.beginPath(); c.arc(sx, sy, 4, 0, 2 * Math.PI); c.fill(); c.stroke();
+  }
   for (const [x, y] of layer.folds) {
     const [sx, sy] = toScreen(x, y);
     c.strokeStyle = "#f33"; c.lineWidth = 2;
@@ -647,8 +658,21 @@ $("layer-rename").onclick = () => {
 $("layer-delete").onclick = () => {
   if (activeLayer()) edit({ op: "delete_layer", layer: editor.activeLayer });
 };
+$("side-colour").onclick = () => sideColour($("colour-picker").value);
+$("side-clear").onclick = () => sideColour(null);
 $("mr-set").onclick = () => refinedEdit(true);
 $("mr-clear").onclick = () => refinedEdit(false);
+
+// The colour of the selected point on the side of the selected face (at a discontinuity).
+function sideColour(css) {
+  if (editor.selection.length !== 1 || editor.face === null) {
+    showMessage("Select one point, then Shift+click inside a face around it.");
+    return;
+  }
+  const op = { op: "set_side_colour", layer: editor.activeLayer, point: editor.selection[0], face: editor.face };
+  if (css) op.css = css;
+  edit(op);
+}
 
 function refinedEdit(set) {
   const number = (id) => Number($(id).value);

@@ -55,7 +55,7 @@ impl History {
             self.current.clone()
         };
         op.apply(&mut next)?;
-        check_picture(&next)?;
+        check_picture(&next, Some(&self.current))?;
         if !continuing {
             self.undo.push(std::mem::replace(&mut self.current, next));
             if self.undo.len() > MAX_HISTORY {
@@ -128,10 +128,12 @@ impl History {
     }
 }
 
-/// Refuses a picture with an invalid layer, with the validator's message.
-pub fn check_picture(picture: &Picture) -> Result<(), String> {
+/// Refuses a picture with an invalid layer, with the validator's message. Layers equal to the
+/// same layer of `checked` (a picture already checked) are not checked again.
+pub fn check_picture(picture: &Picture, checked: Option<&Picture>) -> Result<(), String> {
     for (i, mesh) in picture.doc.layers.iter().enumerate() {
-        if mesh.faces.is_empty() && mesh.points.is_empty() {
+        let unchanged = checked.and_then(|c| c.doc.layers.get(i)) == Some(mesh);
+        if unchanged || (mesh.faces.is_empty() && mesh.points.is_empty()) {
             continue;
         }
         gradmesh::validate(mesh).map_err(|e| {
@@ -259,6 +261,64 @@ mod tests {
         assert!(err.contains("layer 0"), "{err}");
         assert_eq!(h.current(), &square());
         assert!(!h.can_undo_redo().0);
+    }
+
+    #[test]
+    fn the_sides_of_a_discontinuity_take_their_own_colours() {
+        let mut h = History::new(square());
+        let edge = |kind| Op::SetEdge {
+            layer: 0,
+            a: 4,
+            b: 5,
+            kind,
+            sharpness: None,
+        };
+        h.apply(
+            &Op::SplitEdge {
+                layer: 0,
+                a: 0,
+                b: 1,
+            },
+            None,
+        )
+        .unwrap();
+        h.apply(
+            &Op::SplitEdge {
+                layer: 0,
+                a: 2,
+                b: 3,
+            },
+            None,
+        )
+        .unwrap();
+        let split = Op::SplitFace {
+            layer: 0,
+            face: 0,
+            a: 4,
+            b: 5,
+        };
+        h.apply(&split, None).unwrap();
+        h.apply(&edge(crate::ops::EdgeKindName::Discontinuous), None)
+            .unwrap();
+        let side = |face| Op::SetSideColour {
+            layer: 0,
+            point: 4,
+            face,
+            colour: None,
+            css: Some("#00ff00".into()),
+        };
+        h.apply(&side(1), None).unwrap();
+        let mesh = &h.current().doc.layers[0];
+        assert_eq!((mesh.wedges.len(), mesh.wedges[0].face), (1, 1));
+        // Not a corner of the face: refused.
+        let wrong = Op::SetSideColour {
+            layer: 0,
+            point: 1,
+            face: 1,
+            colour: None,
+            css: Some("red".into()),
+        };
+        assert!(h.apply(&wrong, None).is_err());
     }
 
     #[test]

@@ -193,6 +193,22 @@ pub enum Op {
         /// The layer.
         layer: usize,
     },
+    /// Sets the colour of one side of a discontinuity: of `point` in the wedge of faces that
+    /// holds `face`. Neither `colour` nor `css`: the side takes the point's colour again.
+    SetSideColour {
+        /// The layer.
+        layer: usize,
+        /// The point on the discontinuous edge.
+        point: u32,
+        /// A face around the point, on the side to colour.
+        face: u32,
+        /// Coordinates in the layer's colour space.
+        #[serde(default)]
+        colour: Option<[f64; 3]>,
+        /// A CSS colour.
+        #[serde(default)]
+        css: Option<String>,
+    },
     /// Sets or removes the multi-resolution colour and opacity edit of a refined vertex.
     SetRefinedEdit {
         /// The layer.
@@ -277,6 +293,7 @@ impl Op {
             | Op::SetLayerHidden { layer, .. }
             | Op::RenameLayer { layer, .. }
             | Op::DeleteLayer { layer }
+            | Op::SetSideColour { layer, .. }
             | Op::SetRefinedEdit { layer, .. } => *layer,
             Op::AddLayer { .. } => 0,
         }
@@ -317,6 +334,13 @@ impl Op {
                 ..
             } => set_edge(mesh, *a, *b, *kind, *sharpness),
             Op::SplitEdge { a, b, .. } => split_edge(mesh, *a, *b),
+            Op::SetSideColour {
+                point,
+                face,
+                colour,
+                css,
+                ..
+            } => set_side_colour(mesh, *point, *face, *colour, css.as_deref()),
             Op::SplitFace { face, a, b, .. } => split_face(mesh, *face, *a, *b),
             Op::AddFace { points, .. } => {
                 for &p in points {
@@ -393,16 +417,16 @@ fn check_edge(mesh: &GradientMesh, a: u32, b: u32) -> Result<(), String> {
     }
 }
 
-fn set_colour(
-    mesh: &mut GradientMesh,
-    points: &[u32],
+/// A colour given as coordinates or as CSS text, in `space`, with the text to keep.
+fn colour_value(
+    space: ColourSpace,
     colour: Option<[f64; 3]>,
     css: Option<&str>,
-) -> Result<(), String> {
+) -> Result<([f64; 3], Option<String>), String> {
     let (colour, text) = match (colour, css) {
         (Some(c), None) => (c, None),
         (None, Some(text)) => {
-            let (c, _alpha) = parse_css_colour(text, mesh.colour_space)
+            let (c, _alpha) = parse_css_colour(text, space)
                 .map_err(|e| format!("{text:?} is not a colour: {e}"))?;
             (c, Some(text.to_string()))
         }
@@ -411,10 +435,60 @@ fn set_colour(
     if colour.iter().any(|c| !c.is_finite()) {
         return Err("colour coordinates must be finite numbers".into());
     }
+    Ok((colour, text))
+}
+
+fn set_colour(
+    mesh: &mut GradientMesh,
+    points: &[u32],
+    colour: Option<[f64; 3]>,
+    css: Option<&str>,
+) -> Result<(), String> {
+    let (colour, text) = colour_value(mesh.colour_space, colour, css)?;
     for &p in points {
         let point = point_mut(mesh, p)?;
         point.colour = colour;
         point.colour_text = text.clone();
+    }
+    Ok(())
+}
+
+fn set_side_colour(
+    mesh: &mut GradientMesh,
+    point: u32,
+    face: u32,
+    colour: Option<[f64; 3]>,
+    css: Option<&str>,
+) -> Result<(), String> {
+    point_mut(mesh, point)?;
+    let corners = mesh
+        .faces
+        .get(face as usize)
+        .ok_or_else(|| format!("there is no face {face}"))?;
+    if !corners.contains(&point) {
+        return Err(format!("point {point} is not a corner of face {face}"));
+    }
+    let existing = (mesh.wedges.iter()).position(|w| w.point == point && w.face == face);
+    if colour.is_none() && css.is_none() {
+        if let Some(i) = existing {
+            mesh.wedges.remove(i);
+        }
+        return Ok(());
+    }
+    let (colour, text) = colour_value(mesh.colour_space, colour, css)?;
+    match existing {
+        Some(i) => {
+            mesh.wedges[i].colour = colour;
+            mesh.wedges[i].colour_text = text;
+        }
+        None => mesh.wedges.push(gradmesh::WedgeOverride {
+            point,
+            face,
+            colour,
+            colour_text: text,
+            opacity: None,
+            handles: Default::default(),
+        }),
     }
     Ok(())
 }

@@ -108,8 +108,14 @@ fn layer_json(mesh: &GradientMesh, hidden: bool, with_folds: bool) -> Value {
             ])
         })
         .collect();
+    let sides: Vec<Value> = mesh
+        .wedges
+        .iter()
+        .map(|w| json!([w.point, w.face, srgb_hex(space, w.colour)]))
+        .collect();
     json!({
         "name": mesh.name,
+        "sides": sides,
         "space": space.name(),
         "hidden": hidden,
         "points": points,
