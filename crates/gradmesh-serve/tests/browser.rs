@@ -19,7 +19,7 @@ use gradmesh_serve::{start, Config, Running};
 use hyper_util::client::legacy::connect::HttpConnector;
 use serde_json::{json, Value};
 
-const WINDOW: (u32, u32) = (1200, 760);
+const WINDOW: (u32, u32) = (1280, 900);
 
 /// `name` on the `PATH`, or a clear failure.
 fn program(names: &[&str]) -> PathBuf {
