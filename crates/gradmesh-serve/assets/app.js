@@ -21,6 +21,7 @@ const editor = {
   busy: false,          // a batch is out and its answer has not come
   pending: [],          // commands waiting for the answer to the batch out
   drag: null,           // the gesture under way
+  refined: null,        // {layer, face, level, vertices, chosen}: refined vertices shown
   nextGesture: 1,
   error: "",
 };
@@ -97,6 +98,7 @@ function receiveText(message) {
     const layer = activeLayer();
     if (layer) editor.selection = editor.selection.filter((p) => p < layer.points.length);
     if (first) fitView();
+    if (editor.refined) loadRefined(editor.refined.layer, editor.refined.face, editor.refined.level);
     updatePanels();
     drawOverlay();
   }
@@ -307,6 +309,7 @@ function drawOverlay() {
     c.fillStyle = hex; c.strokeStyle = "#000"; c.lineWidth = 1.5;
     c.beginPath(); c.arc(sx, sy, 4, 0, 2 * Math.PI); c.fill(); c.stroke();
   }
+  drawRefined(c);
   for (const [x, y] of layer.folds) {
     const [sx, sy] = toScreen(x, y);
     c.strokeStyle = "#f33"; c.lineWidth = 2;
@@ -314,6 +317,44 @@ function drawOverlay() {
     c.fillStyle = "#f33"; c.font = "bold 12px sans-serif"; c.fillText("fold", sx + 14, sy + 4);
   }
   drawBox(c);
+}
+
+function drawRefined(c) {
+  const r = editor.refined;
+  if (!r || r.layer !== editor.activeLayer) return;
+  for (const v of r.vertices) {
+    const [sx, sy] = toScreen(...v.position);
+    const chosen = r.chosen === v;
+    c.fillStyle = chosen ? "#ff0" : "#0ff";
+    c.strokeStyle = "#000"; c.lineWidth = 1;
+    c.beginPath(); c.arc(sx, sy, chosen ? 4.5 : 2.5, 0, 2 * Math.PI); c.fill(); c.stroke();
+  }
+}
+
+// Fetches the refined vertices of a face at a level, with their addresses.
+async function loadRefined(layer, face, level) {
+  const query = `token=${encodeURIComponent(token)}&layer=${layer}&face=${face}&level=${level}`;
+  const response = await fetch(`/api/refined?${query}`);
+  if (!response.ok) { showMessage(await response.text()); editor.refined = null; drawOverlay(); return; }
+  const chosen = editor.refined && editor.refined.chosen;
+  const vertices = await response.json();
+  editor.refined = { layer, face, level, vertices, chosen: null };
+  if (chosen) {
+    editor.refined.chosen = vertices.find((v) => v.point === chosen.point && v.at[0] === chosen.at[0] && v.at[1] === chosen.at[1]) || null;
+  }
+  drawOverlay();
+}
+
+function pickRefined(sx, sy) {
+  const r = editor.refined;
+  if (!r || r.layer !== editor.activeLayer) return null;
+  let best = null, bestDistance = 6;
+  for (const v of r.vertices) {
+    const [x, y] = toScreen(...v.position);
+    const d = Math.hypot(x - sx, y - sy);
+    if (d < bestDistance) { best = v; bestDistance = d; }
+  }
+  return best;
 }
 
 function handleEnd(layer, from, to) {
@@ -404,6 +445,17 @@ overlay.addEventListener("pointerdown", (event) => {
   }
   const layer = activeLayer();
   if (!layer || layer.hidden) return;
+  const refined = pickRefined(...at);
+  if (refined) {
+    editor.refined.chosen = refined;
+    $("mr-level").value = editor.refined.level;
+    $("mr-face").value = editor.refined.face;
+    $("mr-point").value = refined.point;
+    $("mr-i").value = refined.at[0];
+    $("mr-j").value = refined.at[1];
+    drawOverlay();
+    return;
+  }
   const handle = pickHandle(layer, ...at);
   if (handle) {
     editor.drag = { kind: "handle", handle, start: at, gesture: editor.nextGesture++,
@@ -660,6 +712,11 @@ $("layer-delete").onclick = () => {
 };
 $("side-colour").onclick = () => sideColour($("colour-picker").value);
 $("side-clear").onclick = () => sideColour(null);
+$("mr-show").onclick = () => {
+  if (editor.face === null) { showMessage("Select a face first (click inside it)."); return; }
+  loadRefined(editor.activeLayer, editor.face, Number($("mr-level").value));
+};
+$("mr-hide").onclick = () => { editor.refined = null; drawOverlay(); };
 $("mr-set").onclick = () => refinedEdit(true);
 $("mr-clear").onclick = () => refinedEdit(false);
 

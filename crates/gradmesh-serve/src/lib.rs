@@ -12,6 +12,7 @@
 
 pub mod editor;
 pub mod ops;
+pub mod refined;
 pub mod security;
 pub mod server;
 pub mod session;

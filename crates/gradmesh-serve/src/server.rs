@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use axum::body::Bytes;
 use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
-use axum::extract::{DefaultBodyLimit, State};
+use axum::extract::{DefaultBodyLimit, Query, State};
 use axum::http::{header, StatusCode};
 use axum::response::{Html, IntoResponse, Response};
 use axum::routing::{get, post};
@@ -46,6 +46,7 @@ pub fn router(app: Arc<App>, gate: Gate) -> Router {
         .route("/api/files", get(files))
         .route("/api/document.json", get(document_json))
         .route("/api/picture.png", get(picture_png))
+        .route("/api/refined", get(refined_vertices))
         .route("/ws", get(websocket))
         .fallback(|| async { (StatusCode::NOT_FOUND, "no such page") })
         .layer(DefaultBodyLimit::max(MAX_BODY))
@@ -158,6 +159,40 @@ async fn picture_png(State(app): State<Arc<App>>) -> Response {
             bytes,
         )
             .into_response(),
+        Err(e) => (StatusCode::UNPROCESSABLE_ENTITY, e).into_response(),
+    }
+}
+
+/// Which refined vertices the page asks for.
+#[derive(serde::Deserialize)]
+struct RefinedQuery {
+    layer: usize,
+    face: u32,
+    level: u32,
+}
+
+async fn refined_vertices(State(app): State<Arc<App>>, Query(q): Query<RefinedQuery>) -> Response {
+    let mesh = app
+        .editor()
+        .history
+        .current()
+        .doc
+        .layers
+        .get(q.layer)
+        .cloned();
+    let Some(mesh) = mesh else {
+        return (
+            StatusCode::UNPROCESSABLE_ENTITY,
+            format!("there is no layer {}", q.layer),
+        )
+            .into_response();
+    };
+    let found =
+        tokio::task::spawn_blocking(move || crate::refined::face_vertices(&mesh, q.face, q.level))
+            .await
+            .unwrap_or_else(|_| Err("the refinement failed".into()));
+    match found {
+        Ok(vertices) => axum::Json(vertices).into_response(),
         Err(e) => (StatusCode::UNPROCESSABLE_ENTITY, e).into_response(),
     }
 }

@@ -231,6 +231,23 @@ async fn screenshot(client: &Client, name: &str) {
     }
 }
 
+async fn click_id(client: &Client, id: &str) -> Result<(), String> {
+    let element = client
+        .find(Locator::Id(id))
+        .await
+        .map_err(|e| e.to_string())?;
+    element.click().await.map_err(|e| e.to_string())
+}
+
+async fn type_into(client: &Client, id: &str, text: &str) -> Result<(), String> {
+    let element = client
+        .find(Locator::Id(id))
+        .await
+        .map_err(|e| e.to_string())?;
+    element.clear().await.map_err(|e| e.to_string())?;
+    element.send_keys(text).await.map_err(|e| e.to_string())
+}
+
 /// How many pixels differ between two images of the same size.
 fn differing_pixels(a: &[u8], b: &[u8]) -> usize {
     a.chunks_exact(4)
@@ -405,21 +422,46 @@ async fn run_session(client: &Client, running: &Running, file: &Path) -> Result<
         "the crease changed the picture"
     );
 
-    // A multi-resolution colour edit at level 2.
-    for (id, value) in [
-        ("mr-level", "2"),
-        ("mr-face", "5"),
-        ("mr-point", "7"),
-        ("mr-i", "1"),
-        ("mr-j", "1"),
-    ] {
-        let input = client
-            .find(Locator::Id(id))
-            .await
-            .map_err(|e| e.to_string())?;
-        input.clear().await.map_err(|e| e.to_string())?;
-        input.send_keys(value).await.map_err(|e| e.to_string())?;
+    // A multi-resolution colour edit at level 2: select face 5 (click inside it), show its
+    // refined vertices, click the one at [1, 1] of the sector at point 7.
+    let centre = js(client, "const g = window.gradmesh; const l = g.state.layers[0]; \
+        const c = l.faces[5].map(p => l.points[p]).reduce((a, p) => [a[0] + p[0] / 4, a[1] + p[1] / 4], [0, 0]); \
+        const [x, y] = g.toScreen(...c); \
+        const r = document.getElementById('overlay').getBoundingClientRect(); return [r.left + x, r.top + y];").await;
+    click(
+        client,
+        (centre[0].as_f64().unwrap(), centre[1].as_f64().unwrap()),
+    )
+    .await;
+    assert_eq!(js(client, "return window.gradmesh.face;").await, json!(5));
+    type_into(client, "mr-level", "2").await?;
+    click_id(client, "mr-show").await?;
+    let deadline = Instant::now() + Duration::from_secs(20);
+    while js(client, "return !!window.gradmesh.refined;").await != json!(true) {
+        assert!(
+            Instant::now() < deadline,
+            "the refined vertices did not come"
+        );
+        tokio::time::sleep(Duration::from_millis(50)).await;
     }
+    let count = js(client, "return window.gradmesh.refined.vertices.length;").await;
+    assert_eq!(count, json!(64), "four sectors of 4 x 4 names at level 2");
+    let dot = js(client, "const g = window.gradmesh; \
+        const v = g.refined.vertices.find(v => v.point === 7 && v.at[0] === 1 && v.at[1] === 1); \
+        const [x, y] = g.toScreen(...v.position); \
+        const r = document.getElementById('overlay').getBoundingClientRect(); return [r.left + x, r.top + y];").await;
+    click(client, (dot[0].as_f64().unwrap(), dot[1].as_f64().unwrap())).await;
+    let fields = js(
+        client,
+        "return ['mr-level', 'mr-face', 'mr-point', 'mr-i', 'mr-j'] \
+        .map(id => document.getElementById(id).value);",
+    )
+    .await;
+    assert_eq!(
+        fields,
+        json!(["2", "5", "7", "1", "1"]),
+        "clicking the refined vertex fills in its address"
+    );
     js(
         client,
         "document.getElementById('mr-colour').value = '#00ffff'; return 0;",
