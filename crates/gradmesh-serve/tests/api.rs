@@ -103,9 +103,10 @@ async fn every_route_needs_the_token() {
         let (status, body) = get(&running, route).await;
         assert_eq!(status, 401, "{route} without a token: {body}");
         assert!(body.contains("token"), "{body}");
-        let (status, _) = get(&running, &format!("{route}?token={wrong}")).await;
+        let join = if route.contains('?') { '&' } else { '?' };
+        let (status, _) = get(&running, &format!("{route}{join}token={wrong}")).await;
         assert_eq!(status, 401, "{route} with a wrong token");
-        let (status, _) = get(&running, &format!("{route}?token={token}")).await;
+        let (status, _) = get(&running, &format!("{route}{join}token={token}")).await;
         assert_eq!(status, 200, "{route} with the token");
     }
     let (status, page) = get(&running, &format!("/?token={token}")).await;
