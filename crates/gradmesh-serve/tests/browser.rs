@@ -529,3 +529,95 @@ async fn run_session(client: &Client, running: &Running, file: &Path) -> Result<
     assert_eq!(opened, json!("refused"));
     Ok(())
 }
+
+/// The paper authors' Tucan (six layers, bottom first) as one document in `dir`.
+fn write_tucan(dir: &Path) -> PathBuf {
+    let source = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/realdata/gradientmeshimproved-off");
+    let layers = (0..6)
+        .rev()
+        .map(|i| {
+            let path = source.join(format!("Tucan_Tucan_Layer{i}.off"));
+            let mut doc = gradmesh::formats::read_path(&path)
+                .unwrap_or_else(|e| panic!("the Tucan artwork ({}): {e}", path.display()));
+            doc.layers.remove(0)
+        })
+        .collect();
+    let file = dir.join("tucan.json");
+    let text = gradmesh::formats::json::write_document(&gradmesh::Document { layers });
+    std::fs::write(&file, text).unwrap();
+    file
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_tucan_in_a_real_browser() {
+    let driver = start_driver();
+    let dir = tempfile::tempdir().unwrap();
+    let file = write_tucan(dir.path());
+    let running = start(&Config {
+        file: Some(file),
+        folder: None,
+        port: 0,
+    })
+    .await
+    .unwrap();
+    let client = open_browser(&driver).await;
+    let result = show_tucan(&client, &running).await;
+    client.close().await.ok();
+    result.expect("the browser session");
+}
+
+/// Opens the Tucan, selects the beak's layer and a box of its points, and compares the canvas
+/// with gradmesh's render of the file.
+async fn show_tucan(client: &Client, running: &Running) -> Result<(), String> {
+    client
+        .goto(&running.url())
+        .await
+        .map_err(|e| e.to_string())?;
+    settle(client).await;
+    let layers = js(
+        client,
+        "return document.querySelectorAll('#layers li').length;",
+    )
+    .await;
+    assert_eq!(layers, json!(6), "the layer list shows the six layers");
+    let canvas = canvas_pixels(client).await;
+    let file = dir_file(running);
+    let worst = compare_with_render(client, &file, &canvas).await;
+    assert!(
+        worst <= 2,
+        "the canvas differs from the render of the file by {worst} levels"
+    );
+    // The beak's layer (third in the list, which shows the top layer first) becomes the
+    // active one; a box selects some of its points.
+    let items = client
+        .find_all(Locator::Css("#layers li"))
+        .await
+        .map_err(|e| e.to_string())?;
+    items[2].click().await.map_err(|e| e.to_string())?;
+    let active = js(client, "return window.gradmesh.activeLayer;").await;
+    assert_eq!(active, json!(3));
+    let bounds = js(
+        client,
+        "const r = document.getElementById('overlay').getBoundingClientRect(); \
+        return [r.left, r.top, r.width, r.height];",
+    )
+    .await;
+    let b: Vec<f64> = (0..4).map(|i| bounds[i].as_f64().unwrap()).collect();
+    drag(
+        client,
+        (b[0] + 0.55 * b[2], b[1] + 0.2 * b[3]),
+        (0.25 * b[2], 0.3 * b[3]),
+    )
+    .await;
+    let selected = js(client, "return window.gradmesh.selection.length;").await;
+    assert!(selected.as_u64().unwrap() > 0, "the box selects points");
+    screenshot(client, "editor-tucan.png").await;
+    Ok(())
+}
+
+/// The file the server saves to (the one it opened, here).
+fn dir_file(running: &Running) -> PathBuf {
+    let editor = running.app.editor();
+    editor.path.clone().expect("the document's file")
+}
