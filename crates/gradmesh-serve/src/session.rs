@@ -225,3 +225,90 @@ impl Session {
 pub fn error_message(message: &str) -> Outgoing {
     Outgoing::Error(serde_json::json!({"type": "error", "message": message}).to_string())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::editor::History;
+    use crate::ops::Picture;
+
+    fn square_session() -> Session {
+        let mut picture = Picture::default();
+        Op::AddLayer { name: None }.apply(&mut picture).unwrap();
+        Op::AddRectangle {
+            layer: 0,
+            rect: [0.0, 0.0, 100.0, 100.0],
+        }
+        .apply(&mut picture)
+        .unwrap();
+        let app = App {
+            editor: Mutex::new(Editor {
+                history: History::new(picture),
+                path: None,
+            }),
+            folder: Folder::new(&std::env::temp_dir()).unwrap(),
+        };
+        Session::new(Arc::new(app))
+    }
+
+    fn count(out: &[Outgoing]) -> (usize, usize, usize, usize) {
+        let mut n = (0, 0, 0, 0);
+        for message in out {
+            match message {
+                Outgoing::Binary(_) => n.0 += 1,
+                Outgoing::Text(_) => n.1 += 1,
+                Outgoing::Error(_) => n.2 += 1,
+                Outgoing::Done => n.3 += 1,
+            }
+        }
+        n
+    }
+
+    #[test]
+    fn a_batch_of_drag_moves_gives_one_frame_of_the_last() {
+        let mut session = square_session();
+        let view = r#"{"type":"view","width":200,"height":200,"view":[-10,-10,110,110]}"#;
+        assert_eq!(
+            count(&session.handle_texts(&[view.to_string()])),
+            (1, 1, 0, 1)
+        );
+        let moves: Vec<String> = (1..=20)
+            .map(|dx| {
+                format!(
+                    r#"{{"type":"edit","gesture":3,"op":{{"op":"move_points","layer":0,"points":[0],"dx":{dx},"dy":0}}}}"#
+                )
+            })
+            .collect();
+        assert_eq!(count(&session.handle_texts(&moves)), (1, 1, 0, 1));
+        let editor = session.app.editor();
+        assert_eq!(
+            editor.history.current().doc.layers[0].points[0].position.x,
+            20.0
+        );
+        drop(editor);
+        // One undo step takes the whole drag back.
+        session.handle_texts(&[r#"{"type":"undo"}"#.to_string()]);
+        let editor = session.app.editor();
+        assert_eq!(
+            editor.history.current().doc.layers[0].points[0].position.x,
+            0.0
+        );
+        assert!(!editor.history.can_undo_redo().0);
+    }
+
+    #[test]
+    fn nothing_changed_gives_no_frame_and_bad_commands_an_error_each() {
+        let mut session = square_session();
+        let view = r#"{"type":"view","width":64,"height":64,"view":[0,0,100,100]}"#;
+        session.handle_texts(&[view.to_string()]);
+        assert_eq!(
+            count(&session.handle_texts(&[r#"{"type":"state"}"#.to_string()])),
+            (0, 0, 0, 1)
+        );
+        let bad = [
+            "{".to_string(),
+            r#"{"type":"view","width":0,"height":1,"view":[0,0,1,1]}"#.to_string(),
+        ];
+        assert_eq!(count(&session.handle_texts(&bad)), (0, 0, 2, 1));
+    }
+}
