@@ -326,3 +326,34 @@ async fn saving_is_whole_and_a_page_leaving_mid_edit_loses_nothing_saved() {
     );
     assert_eq!(read_x0(&dir.path().join("copy.json")), x_now);
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_new_document_is_drawn_and_saved_as() {
+    let dir = tempfile::tempdir().unwrap();
+    let running = start(&Config {
+        file: None,
+        folder: Some(dir.path().to_path_buf()),
+        port: 0,
+    })
+    .await
+    .unwrap();
+    let rectangle = r#"{"type":"edit","op":{"op":"add_rectangle","layer":0,"rect":[0,0,40,30]}}"#;
+    assert_eq!(command(&running, rectangle).await.0, 200);
+    let (status, body) = command(&running, r#"{"type":"save"}"#).await;
+    assert_eq!(status, 422, "{body}");
+    assert!(body.contains("Save as"), "{body}");
+    let (status, _) = command(&running, r#"{"type":"save_as","name":"new.json"}"#).await;
+    assert_eq!(status, 200);
+    let doc = gradmesh::formats::read_path(&dir.path().join("new.json")).unwrap();
+    assert_eq!(
+        (doc.layers[0].points.len(), doc.layers[0].faces.len()),
+        (4, 1)
+    );
+    let (status, png) = get(
+        &running,
+        &format!("/api/picture.png?token={}", running.token),
+    )
+    .await;
+    assert_eq!(status, 200);
+    assert!(png.contains("PNG"));
+}
