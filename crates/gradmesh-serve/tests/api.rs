@@ -356,4 +356,13 @@ async fn a_new_document_is_drawn_and_saved_as() {
     .await;
     assert_eq!(status, 200);
     assert!(png.contains("PNG"));
+    // Open another document of the folder: a copy of the example with its creases.
+    let example =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/edge-kinds.json");
+    std::fs::copy(example, dir.path().join("edges.json")).unwrap();
+    let (status, state) = command(&running, r#"{"type":"open","name":"edges.json"}"#).await;
+    assert_eq!(status, 200, "{state}");
+    assert!(state.contains(r#""file":"edges.json""#), "{state}");
+    assert!(state.contains(r#""crease""#), "{state}");
+    assert!(state.contains(r#""can_undo":false"#), "{state}");
 }
