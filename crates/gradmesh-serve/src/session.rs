@@ -9,7 +9,7 @@ use serde::Deserialize;
 use crate::editor::Editor;
 use crate::ops::Op;
 use crate::security::Folder;
-use crate::state::Status;
+use crate::state::{FoldCache, Status};
 use crate::viewer::{Viewer, Viewport};
 
 /// The server's shared state: the document being edited and the folder it lives in.
@@ -91,8 +91,9 @@ pub enum Outgoing {
 pub struct Session {
     app: Arc<App>,
     viewer: Viewer,
-    /// The history version the page last got the state of.
+    /// The history version the page last got the state of, and whether a gesture was open.
     told_version: Option<(u64, bool)>,
+    folds: FoldCache,
 }
 
 impl Session {
@@ -102,6 +103,7 @@ impl Session {
             app,
             viewer: Viewer::new(),
             told_version: None,
+            folds: FoldCache::default(),
         }
     }
 
@@ -134,37 +136,41 @@ impl Session {
                 out.push(error_message(&message));
             }
         }
-        let (doc, version, gesture_open, status) = {
-            let editor = self.app.editor();
-            let h = &editor.history;
-            let gesture_open = h.gesture_open();
-            let key = (h.version(), gesture_open);
-            let status = (self.told_version != Some(key)).then(|| {
-                let (can_undo, can_redo) = h.can_undo_redo();
-                Status {
-                    picture: h.current(),
-                    file: editor.path.as_deref().map(|p| self.app.folder.name_of(p)),
-                    modified: h.modified(),
-                    can_undo,
-                    can_redo,
-                    with_folds: !gesture_open,
-                }
-                .to_json()
-                .to_string()
-            });
-            (h.current().visible(), key.0, gesture_open, status)
-        };
+        let doc = self.app.editor().history.current().visible();
         match self.viewer.render(&doc) {
             Ok(Some(frame)) => out.push(Outgoing::Binary(frame)),
             Ok(None) => {}
             Err(e) => out.push(error_message(&format!("cannot render: {e}"))),
         }
-        if let Some(status) = status {
-            self.told_version = Some((version, gesture_open));
+        if let Some(status) = self.status_if_changed() {
             out.push(Outgoing::Text(status));
         }
         out.push(Outgoing::Done);
         out
+    }
+
+    /// The state message, if the picture changed since the page was last told. Folds are
+    /// looked for only when no gesture is open, and only in the layers that changed.
+    fn status_if_changed(&mut self) -> Option<String> {
+        let app = Arc::clone(&self.app);
+        let editor = app.editor();
+        let h = &editor.history;
+        let key = (h.version(), h.gesture_open());
+        if self.told_version == Some(key) {
+            return None;
+        }
+        let folds = (!key.1).then(|| self.folds.folds(&h.current().doc.layers));
+        let (can_undo, can_redo) = h.can_undo_redo();
+        let status = Status {
+            picture: h.current(),
+            file: editor.path.as_deref().map(|p| app.folder.name_of(p)),
+            modified: h.modified(),
+            can_undo,
+            can_redo,
+            folds,
+        };
+        self.told_version = Some(key);
+        Some(status.to_json().to_string())
     }
 
     /// Runs one command.

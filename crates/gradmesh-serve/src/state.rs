@@ -19,16 +19,58 @@ pub struct Status<'a> {
     pub can_undo: bool,
     /// See `can_undo`.
     pub can_redo: bool,
-    /// Whether to look for folds (a refinement of every layer to level 4): skipped while a
-    /// gesture runs.
-    pub with_folds: bool,
+    /// The folds of each layer (centre and area), or `None` while a gesture runs (finding
+    /// them refines every changed layer to level 4).
+    pub folds: Option<Vec<Vec<[f64; 3]>>>,
+}
+
+/// The folds found in each layer, kept with the layer they were found in, so that only changed
+/// layers are searched again.
+#[derive(Default)]
+pub struct FoldCache {
+    layers: Vec<Option<(GradientMesh, Vec<[f64; 3]>)>>,
+}
+
+impl FoldCache {
+    /// The folds of each of `layers`: centre x, y and area.
+    pub fn folds(&mut self, layers: &[GradientMesh]) -> Vec<Vec<[f64; 3]>> {
+        self.layers.resize(layers.len(), None);
+        (layers.iter().zip(&mut self.layers))
+            .map(|(mesh, kept)| match kept {
+                Some((seen, folds)) if seen == mesh => folds.clone(),
+                _ => {
+                    let folds = find_folds(mesh);
+                    *kept = Some((mesh.clone(), folds.clone()));
+                    folds
+                }
+            })
+            .collect()
+    }
+}
+
+fn find_folds(mesh: &GradientMesh) -> Vec<[f64; 3]> {
+    if mesh.faces.is_empty() {
+        return Vec::new();
+    }
+    gradmesh::render::find_folds(mesh)
+        .map(|folds| {
+            folds
+                .iter()
+                .map(|f| [f.position.x, f.position.y, f.area])
+                .collect()
+        })
+        .unwrap_or_default()
 }
 
 impl Status<'_> {
     /// The state message.
     pub fn to_json(&self) -> Value {
         let layers: Vec<Value> = (self.picture.doc.layers.iter().zip(&self.picture.hidden))
-            .map(|(mesh, &hidden)| layer_json(mesh, hidden, self.with_folds))
+            .enumerate()
+            .map(|(i, (mesh, &hidden))| {
+                let folds = self.folds.as_ref().and_then(|f| f.get(i));
+                layer_json(mesh, hidden, folds.map(Vec::as_slice))
+            })
             .collect();
         json!({
             "type": "state",
@@ -36,13 +78,13 @@ impl Status<'_> {
             "modified": self.modified,
             "can_undo": self.can_undo,
             "can_redo": self.can_redo,
-            "folds_checked": self.with_folds,
+            "folds_checked": self.folds.is_some(),
             "layers": layers,
         })
     }
 }
 
-fn layer_json(mesh: &GradientMesh, hidden: bool, with_folds: bool) -> Value {
+fn layer_json(mesh: &GradientMesh, hidden: bool, folds: Option<&[[f64; 3]]>) -> Value {
     let space = mesh.colour_space;
     let points: Vec<[f64; 2]> = mesh
         .points
@@ -84,18 +126,7 @@ fn layer_json(mesh: &GradientMesh, hidden: bool, with_folds: bool) -> Value {
             json!([a, b, kind, tag.sharpness])
         })
         .collect();
-    let folds: Vec<Value> = if with_folds && !mesh.faces.is_empty() {
-        gradmesh::render::find_folds(mesh)
-            .map(|folds| {
-                folds
-                    .iter()
-                    .map(|f| json!([f.position.x, f.position.y, f.area]))
-                    .collect()
-            })
-            .unwrap_or_default()
-    } else {
-        Vec::new()
-    };
+    let folds = folds.unwrap_or_default();
     let edits: Vec<Value> = mesh
         .edits
         .iter()
