@@ -366,3 +366,27 @@ async fn a_new_document_is_drawn_and_saved_as() {
     assert!(state.contains(r#""crease""#), "{state}");
     assert!(state.contains(r#""can_undo":false"#), "{state}");
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_oversized_websocket_message_closes_only_that_connection() {
+    let (running, _dir) = serve_square().await;
+    let own = format!("http://127.0.0.1:{}", running.address.port());
+    let mut socket = open_socket(&running, &running.token, &own).await.unwrap();
+    let huge = format!(r#"{{"type":"open","name":"{}"}}"#, "a".repeat(2 << 20));
+    let _ = socket.send(Message::Text(huge.into())).await;
+    // The server ends the connection: the stream closes (or errs) instead of waiting.
+    let ended = tokio::time::timeout(std::time::Duration::from_secs(10), async {
+        while let Some(Ok(message)) = socket.next().await {
+            if let Message::Close(_) = message {
+                break;
+            }
+        }
+    })
+    .await;
+    assert!(
+        ended.is_ok(),
+        "the connection stays open after an oversized message"
+    );
+    let (status, _) = get(&running, &format!("/api/state?token={}", running.token)).await;
+    assert_eq!(status, 200, "the server goes on");
+}
