@@ -29,6 +29,23 @@ pub enum Command {
     Render(RenderArgs),
     /// List the multi-resolution edits of a mesh: the vertex each names, and what it changes.
     Edits(EditsArgs),
+    /// Start the local web editor and print its URL (listens on 127.0.0.1 only).
+    Serve(ServeArgs),
+}
+
+/// Flags of `gradmesh serve`.
+#[derive(Debug, Args)]
+pub struct ServeArgs {
+    /// The document to open (.json, .off, .obj, .svg); without it, a new document. Saving
+    /// writes JSON beside it (the same file if it is JSON).
+    pub file: Option<PathBuf>,
+    /// The port on 127.0.0.1 (0: any free port).
+    #[arg(long, default_value_t = 0)]
+    pub port: u16,
+    /// The folder documents are opened from and saved to (default: FILE's folder, else the
+    /// current folder). The editor reads and writes nothing outside it.
+    #[arg(long, value_name = "DIR")]
+    pub folder: Option<PathBuf>,
 }
 
 /// The paper's options (section 4.5), applied to every layer; without them each layer keeps

@@ -5,6 +5,7 @@ mod edits;
 mod info;
 mod refine;
 mod render;
+mod serve;
 
 use std::path::Path;
 
@@ -34,6 +35,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         Command::Refine(a) => Ok(refine::run(&a)?),
         Command::Render(a) => Ok(render::run(&a)?),
         Command::Edits(a) => Ok(edits::run(&a)?),
+        Command::Serve(a) => Ok(serve::run(&a)?),
     }
 }
 

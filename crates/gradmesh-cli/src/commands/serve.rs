@@ -1,0 +1,15 @@
+//! `gradmesh serve`: the local web editor of `gradmesh-serve`.
+
+use gradmesh::{Error, ErrorKind};
+
+use crate::args::ServeArgs;
+
+/// Serves the editor until the process is stopped.
+pub fn run(args: &ServeArgs) -> Result<(), Error> {
+    let config = gradmesh_serve::Config {
+        file: args.file.clone(),
+        folder: args.folder.clone(),
+        port: args.port,
+    };
+    gradmesh_serve::run(&config).map_err(|message| Error::new(ErrorKind::Io(message)))
+}

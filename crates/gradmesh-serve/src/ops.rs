@@ -1,0 +1,722 @@
+//! The edits the editor makes to a document, as the page sends them.
+//!
+//! Each [`Op`] changes a [`Picture`] (the document and which layers are hidden); the
+//! [`History`](crate::editor::History) checks the result with the library's validator and
+//! refuses it whole if any layer is invalid.
+
+use gradmesh::{
+    parse_css_colour, ColourSpace, Document, EdgeKind, Edit, GradientMesh, SHARPNESS_INFINITE,
+};
+use kurbo::{CubicBez, ParamCurve, Point, Vec2};
+use serde::Deserialize;
+
+/// What the editor shows: the document and, per layer, whether it is hidden.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Picture {
+    /// The document.
+    pub doc: Document,
+    /// Per layer: hidden (not drawn, still saved).
+    pub hidden: Vec<bool>,
+}
+
+impl Picture {
+    /// A picture of `doc` with every layer shown.
+    pub fn new(doc: Document) -> Picture {
+        let hidden = vec![false; doc.layers.len()];
+        Picture { doc, hidden }
+    }
+
+    /// The document of the layers shown.
+    pub fn visible(&self) -> Document {
+        Document {
+            layers: (self.doc.layers.iter().zip(&self.hidden))
+                .filter(|(_, hidden)| !**hidden)
+                .map(|(layer, _)| layer.clone())
+                .collect(),
+        }
+    }
+}
+
+/// The kind of an edge as the page names it.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(rename_all = "snake_case")]
+pub enum EdgeKindName {
+    /// C1.
+    Smooth,
+    /// C0, with a sharpness (absent: infinitely sharp).
+    Crease,
+    /// C-1.
+    Discontinuous,
+}
+
+/// One edit of the picture. Point and face indices are those of the layer's mesh.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(tag = "op", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Op {
+    /// Moves `points` by `(dx, dy)`.
+    MovePoints {
+        /// The layer.
+        layer: usize,
+        /// The points.
+        points: Vec<u32>,
+        /// Offset in x.
+        dx: f64,
+        /// Offset in y.
+        dy: f64,
+    },
+    /// Sets the handle of point `from` towards `to` (relative to `from`).
+    SetHandle {
+        /// The layer.
+        layer: usize,
+        /// The point the handle belongs to.
+        from: u32,
+        /// The neighbour it points to.
+        to: u32,
+        /// The handle vector's x.
+        x: f64,
+        /// The handle vector's y.
+        y: f64,
+    },
+    /// Sets the colour of `points`: coordinates in the layer's colour space, or a CSS colour.
+    SetColour {
+        /// The layer.
+        layer: usize,
+        /// The points.
+        points: Vec<u32>,
+        /// Coordinates in the layer's colour space.
+        #[serde(default)]
+        colour: Option<[f64; 3]>,
+        /// A CSS colour (`#rrggbb`, `rgb(...)`, names).
+        #[serde(default)]
+        css: Option<String>,
+    },
+    /// Sets the opacity of `points`.
+    SetOpacity {
+        /// The layer.
+        layer: usize,
+        /// The points.
+        points: Vec<u32>,
+        /// Opacity in 0..=1.
+        opacity: f64,
+    },
+    /// Tags the edge between `a` and `b`.
+    SetEdge {
+        /// The layer.
+        layer: usize,
+        /// One end.
+        a: u32,
+        /// The other end.
+        b: u32,
+        /// Smooth, crease or discontinuous.
+        kind: EdgeKindName,
+        /// A crease's sharpness (absent: infinite).
+        #[serde(default)]
+        sharpness: Option<f64>,
+    },
+    /// Adds a point in the middle of the edge between `a` and `b`, in every face along it.
+    SplitEdge {
+        /// The layer.
+        layer: usize,
+        /// One end.
+        a: u32,
+        /// The other end.
+        b: u32,
+    },
+    /// Splits a face in two along a new edge between two of its corners.
+    SplitFace {
+        /// The layer.
+        layer: usize,
+        /// The face.
+        face: u32,
+        /// One corner.
+        a: u32,
+        /// Another corner, not next to `a`.
+        b: u32,
+    },
+    /// Adds a face with the given corners, in order.
+    AddFace {
+        /// The layer.
+        layer: usize,
+        /// The corners.
+        points: Vec<u32>,
+    },
+    /// Adds a new rectangular patch of four points to a layer.
+    AddRectangle {
+        /// The layer.
+        layer: usize,
+        /// Left, top, right, bottom.
+        rect: [f64; 4],
+    },
+    /// Deletes points and the faces that use them.
+    DeletePoints {
+        /// The layer.
+        layer: usize,
+        /// The points.
+        points: Vec<u32>,
+    },
+    /// Deletes faces and the points no face uses any more.
+    DeleteFaces {
+        /// The layer.
+        layer: usize,
+        /// The faces.
+        faces: Vec<u32>,
+    },
+    /// Adds an empty layer on top.
+    AddLayer {
+        /// Its name.
+        #[serde(default)]
+        name: Option<String>,
+    },
+    /// Moves a layer to another place in the stack.
+    MoveLayer {
+        /// The layer.
+        layer: usize,
+        /// Its new index.
+        to: usize,
+    },
+    /// Hides or shows a layer.
+    SetLayerHidden {
+        /// The layer.
+        layer: usize,
+        /// Hidden or not.
+        hidden: bool,
+    },
+    /// Renames a layer.
+    RenameLayer {
+        /// The layer.
+        layer: usize,
+        /// The new name (empty: none).
+        name: String,
+    },
+    /// Deletes a layer.
+    DeleteLayer {
+        /// The layer.
+        layer: usize,
+    },
+    /// Sets the colour of one side of a discontinuity: of `point` in the wedge of faces that
+    /// holds `face`. Neither `colour` nor `css`: the side takes the point's colour again.
+    SetSideColour {
+        /// The layer.
+        layer: usize,
+        /// The point on the discontinuous edge.
+        point: u32,
+        /// A face around the point, on the side to colour.
+        face: u32,
+        /// Coordinates in the layer's colour space.
+        #[serde(default)]
+        colour: Option<[f64; 3]>,
+        /// A CSS colour.
+        #[serde(default)]
+        css: Option<String>,
+    },
+    /// Sets or removes the multi-resolution colour and opacity edit of a refined vertex.
+    SetRefinedEdit {
+        /// The layer.
+        layer: usize,
+        /// Level of the refined vertex (1 or more).
+        level: u32,
+        /// The control face it lies in.
+        face: u32,
+        /// The corner of that face whose sector holds it.
+        point: u32,
+        /// Its place in the sector's grid.
+        at: [u32; 2],
+        /// New colour in the layer's space (absent: no colour edit).
+        #[serde(default)]
+        colour: Option<[f64; 3]>,
+        /// New opacity (absent: no opacity edit).
+        #[serde(default)]
+        opacity: Option<f64>,
+    },
+}
+
+impl Op {
+    /// Applies the edit to `picture`. Fails with a message for the user when the edit names
+    /// nothing that exists or makes no sense; the validity of the result is checked apart.
+    pub fn apply(&self, picture: &mut Picture) -> Result<(), String> {
+        match self {
+            Op::AddLayer { name } => {
+                let mut mesh = GradientMesh::new(ColourSpace::Lab);
+                mesh.name = name.clone();
+                picture.doc.layers.push(mesh);
+                picture.hidden.push(false);
+                Ok(())
+            }
+            Op::MoveLayer { layer, to } => {
+                check_layer(picture, *layer)?;
+                check_layer(picture, *to)?;
+                let mesh = picture.doc.layers.remove(*layer);
+                let hidden = picture.hidden.remove(*layer);
+                picture.doc.layers.insert(*to, mesh);
+                picture.hidden.insert(*to, hidden);
+                Ok(())
+            }
+            Op::SetLayerHidden { layer, hidden } => {
+                check_layer(picture, *layer)?;
+                picture.hidden[*layer] = *hidden;
+                Ok(())
+            }
+            Op::RenameLayer { layer, name } => {
+                check_layer(picture, *layer)?;
+                picture.doc.layers[*layer].name = (!name.is_empty()).then(|| name.clone());
+                Ok(())
+            }
+            Op::DeleteLayer { layer } => {
+                check_layer(picture, *layer)?;
+                picture.doc.layers.remove(*layer);
+                picture.hidden.remove(*layer);
+                Ok(())
+            }
+            _ => {
+                let layer = self.layer();
+                check_layer(picture, layer)?;
+                self.apply_to_mesh(&mut picture.doc.layers[layer])
+            }
+        }
+    }
+
+    /// The layer an edit of one mesh changes.
+    fn layer(&self) -> usize {
+        match self {
+            Op::MovePoints { layer, .. }
+            | Op::SetHandle { layer, .. }
+            | Op::SetColour { layer, .. }
+            | Op::SetOpacity { layer, .. }
+            | Op::SetEdge { layer, .. }
+            | Op::SplitEdge { layer, .. }
+            | Op::SplitFace { layer, .. }
+            | Op::AddFace { layer, .. }
+            | Op::AddRectangle { layer, .. }
+            | Op::DeletePoints { layer, .. }
+            | Op::DeleteFaces { layer, .. }
+            | Op::MoveLayer { layer, .. }
+            | Op::SetLayerHidden { layer, .. }
+            | Op::RenameLayer { layer, .. }
+            | Op::DeleteLayer { layer }
+            | Op::SetSideColour { layer, .. }
+            | Op::SetRefinedEdit { layer, .. } => *layer,
+            Op::AddLayer { .. } => 0,
+        }
+    }
+
+    fn apply_to_mesh(&self, mesh: &mut GradientMesh) -> Result<(), String> {
+        match self {
+            Op::MovePoints { points, dx, dy, .. } => {
+                for &p in points {
+                    point_mut(mesh, p)?.position += Vec2::new(*dx, *dy);
+                }
+                Ok(())
+            }
+            Op::SetHandle { from, to, x, y, .. } => {
+                check_edge(mesh, *from, *to)?;
+                mesh.set_handle(*from, *to, Vec2::new(*x, *y));
+                Ok(())
+            }
+            Op::SetColour {
+                points,
+                colour,
+                css,
+                ..
+            } => set_colour(mesh, points, *colour, css.as_deref()),
+            Op::SetOpacity {
+                points, opacity, ..
+            } => {
+                for &p in points {
+                    point_mut(mesh, p)?.opacity = *opacity;
+                }
+                Ok(())
+            }
+            Op::SetEdge {
+                a,
+                b,
+                kind,
+                sharpness,
+                ..
+            } => set_edge(mesh, *a, *b, *kind, *sharpness),
+            Op::SplitEdge { a, b, .. } => split_edge(mesh, *a, *b),
+            Op::SetSideColour {
+                point,
+                face,
+                colour,
+                css,
+                ..
+            } => set_side_colour(mesh, *point, *face, *colour, css.as_deref()),
+            Op::SplitFace { face, a, b, .. } => split_face(mesh, *face, *a, *b),
+            Op::AddFace { points, .. } => {
+                for &p in points {
+                    point_mut(mesh, p)?;
+                }
+                mesh.add_face(points.clone());
+                Ok(())
+            }
+            Op::AddRectangle { rect, .. } => {
+                add_rectangle(mesh, *rect);
+                Ok(())
+            }
+            Op::DeletePoints { points, .. } => delete_points(mesh, points),
+            Op::DeleteFaces { faces, .. } => delete_faces(mesh, faces),
+            Op::SetRefinedEdit {
+                level,
+                face,
+                point,
+                at,
+                colour,
+                opacity,
+                ..
+            } => {
+                let address = gradmesh::VertexAddress {
+                    level: *level,
+                    face: *face,
+                    point: *point,
+                    at: *at,
+                };
+                set_refined_edit(mesh, address, *colour, *opacity)
+            }
+            Op::AddLayer { .. }
+            | Op::MoveLayer { .. }
+            | Op::SetLayerHidden { .. }
+            | Op::RenameLayer { .. }
+            | Op::DeleteLayer { .. } => unreachable!("layer edits are applied to the picture"),
+        }
+    }
+}
+
+fn check_layer(picture: &Picture, layer: usize) -> Result<(), String> {
+    if layer < picture.doc.layers.len() {
+        Ok(())
+    } else {
+        Err(format!(
+            "there is no layer {layer} (the document has {})",
+            picture.doc.layers.len()
+        ))
+    }
+}
+
+fn point_mut(mesh: &mut GradientMesh, p: u32) -> Result<&mut gradmesh::ControlPoint, String> {
+    let count = mesh.points.len();
+    mesh.points
+        .get_mut(p as usize)
+        .ok_or_else(|| format!("there is no point {p} (the layer has {count})"))
+}
+
+/// Whether `a` and `b` are joined by an edge of some face.
+fn is_edge(mesh: &GradientMesh, a: u32, b: u32) -> bool {
+    mesh.faces.iter().any(|face| {
+        (0..face.len()).any(|i| {
+            let (p, q) = (face[i], face[(i + 1) % face.len()]);
+            (p, q) == (a, b) || (p, q) == (b, a)
+        })
+    })
+}
+
+fn check_edge(mesh: &GradientMesh, a: u32, b: u32) -> Result<(), String> {
+    if is_edge(mesh, a, b) {
+        Ok(())
+    } else {
+        Err(format!("points {a} and {b} are not joined by an edge"))
+    }
+}
+
+/// A colour given as coordinates or as CSS text, in `space`, with the text to keep.
+fn colour_value(
+    space: ColourSpace,
+    colour: Option<[f64; 3]>,
+    css: Option<&str>,
+) -> Result<([f64; 3], Option<String>), String> {
+    let (colour, text) = match (colour, css) {
+        (Some(c), None) => (c, None),
+        (None, Some(text)) => {
+            let (c, _alpha) = parse_css_colour(text, space)
+                .map_err(|e| format!("{text:?} is not a colour: {e}"))?;
+            (c, Some(text.to_string()))
+        }
+        _ => return Err("give either a colour's coordinates or a CSS colour".into()),
+    };
+    if colour.iter().any(|c| !c.is_finite()) {
+        return Err("colour coordinates must be finite numbers".into());
+    }
+    Ok((colour, text))
+}
+
+fn set_colour(
+    mesh: &mut GradientMesh,
+    points: &[u32],
+    colour: Option<[f64; 3]>,
+    css: Option<&str>,
+) -> Result<(), String> {
+    let (colour, text) = colour_value(mesh.colour_space, colour, css)?;
+    for &p in points {
+        let point = point_mut(mesh, p)?;
+        point.colour = colour;
+        point.colour_text = text.clone();
+    }
+    Ok(())
+}
+
+fn set_side_colour(
+    mesh: &mut GradientMesh,
+    point: u32,
+    face: u32,
+    colour: Option<[f64; 3]>,
+    css: Option<&str>,
+) -> Result<(), String> {
+    point_mut(mesh, point)?;
+    let corners = mesh
+        .faces
+        .get(face as usize)
+        .ok_or_else(|| format!("there is no face {face}"))?;
+    if !corners.contains(&point) {
+        return Err(format!("point {point} is not a corner of face {face}"));
+    }
+    let existing = (mesh.wedges.iter()).position(|w| w.point == point && w.face == face);
+    if colour.is_none() && css.is_none() {
+        if let Some(i) = existing {
+            mesh.wedges.remove(i);
+        }
+        return Ok(());
+    }
+    let (colour, text) = colour_value(mesh.colour_space, colour, css)?;
+    match existing {
+        Some(i) => {
+            mesh.wedges[i].colour = colour;
+            mesh.wedges[i].colour_text = text;
+        }
+        None => mesh.wedges.push(gradmesh::WedgeOverride {
+            point,
+            face,
+            colour,
+            colour_text: text,
+            opacity: None,
+            handles: Default::default(),
+        }),
+    }
+    Ok(())
+}
+
+fn set_edge(
+    mesh: &mut GradientMesh,
+    a: u32,
+    b: u32,
+    kind: EdgeKindName,
+    sharpness: Option<f64>,
+) -> Result<(), String> {
+    check_edge(mesh, a, b)?;
+    let (kind, sharpness) = match kind {
+        EdgeKindName::Smooth => (EdgeKind::Smooth, None),
+        EdgeKindName::Crease => match sharpness {
+            Some(s) if s >= SHARPNESS_INFINITE => (EdgeKind::Crease, None),
+            s => (EdgeKind::Crease, s),
+        },
+        EdgeKindName::Discontinuous => (EdgeKind::Discontinuous, None),
+    };
+    mesh.set_edge(a, b, kind, sharpness);
+    Ok(())
+}
+
+/// The edge's curve from `a` to `b`: a cubic through the two handles.
+fn edge_curve(mesh: &GradientMesh, a: u32, b: u32) -> CubicBez {
+    let (pa, pb) = (
+        mesh.points[a as usize].position,
+        mesh.points[b as usize].position,
+    );
+    CubicBez::new(pa, pa + mesh.handle(a, b), pb + mesh.handle(b, a), pb)
+}
+
+fn split_edge(mesh: &mut GradientMesh, a: u32, b: u32) -> Result<(), String> {
+    check_edge(mesh, a, b)?;
+    let curve = edge_curve(mesh, a, b);
+    let (first, second) = curve.subdivide();
+    let (ca, cb) = (&mesh.points[a as usize], &mesh.points[b as usize]);
+    let colour = [0, 1, 2].map(|i| (ca.colour[i] + cb.colour[i]) / 2.0);
+    let opacity = (ca.opacity + cb.opacity) / 2.0;
+    let m = mesh.add_point(curve.eval(0.5), colour);
+    mesh.points[m as usize].opacity = opacity;
+    for face in &mut mesh.faces {
+        let n = face.len();
+        if let Some(i) = (0..n).find(|&i| {
+            let (p, q) = (face[i], face[(i + 1) % n]);
+            (p, q) == (a, b) || (p, q) == (b, a)
+        }) {
+            face.insert(i + 1, m);
+        }
+    }
+    let tag = mesh.edge_tag(a, b);
+    mesh.edges.remove(&gradmesh_edge_key(a, b));
+    mesh.handles.remove(&(a, b));
+    mesh.handles.remove(&(b, a));
+    mesh.set_handle(a, m, first.p1 - first.p0);
+    mesh.set_handle(m, a, first.p2 - first.p3);
+    mesh.set_handle(m, b, second.p1 - second.p0);
+    mesh.set_handle(b, m, second.p2 - second.p3);
+    mesh.set_edge(a, m, tag.kind, tag.sharpness);
+    mesh.set_edge(m, b, tag.kind, tag.sharpness);
+    Ok(())
+}
+
+fn gradmesh_edge_key(a: u32, b: u32) -> (u32, u32) {
+    (a.min(b), a.max(b))
+}
+
+fn split_face(mesh: &mut GradientMesh, face: u32, a: u32, b: u32) -> Result<(), String> {
+    let corners = mesh
+        .faces
+        .get(face as usize)
+        .ok_or_else(|| format!("there is no face {face}"))?
+        .clone();
+    let n = corners.len();
+    let find = |p: u32| {
+        corners
+            .iter()
+            .position(|&c| c == p)
+            .ok_or_else(|| format!("point {p} is not a corner of face {face}"))
+    };
+    let (i, j) = (find(a)?, find(b)?);
+    let gap = (j + n - i) % n;
+    if gap < 2 || gap > n - 2 {
+        return Err(format!(
+            "points {a} and {b} are next to each other (or the same): the face cannot be split between them"
+        ));
+    }
+    let first: Vec<u32> = (0..=gap).map(|k| corners[(i + k) % n]).collect();
+    let second: Vec<u32> = (gap..=n).map(|k| corners[(i + k) % n]).collect();
+    mesh.faces[face as usize] = first;
+    mesh.faces.push(second);
+    Ok(())
+}
+
+fn add_rectangle(mesh: &mut GradientMesh, [x0, y0, x1, y1]: [f64; 4]) {
+    let palette: [[f64; 3]; 4] = match mesh.colour_space {
+        ColourSpace::Lab => [
+            [60.0, 60.0, 40.0],
+            [85.0, -10.0, 80.0],
+            [50.0, -40.0, -30.0],
+            [40.0, 50.0, -60.0],
+        ],
+        _ => [
+            [0.9, 0.3, 0.2],
+            [0.95, 0.85, 0.2],
+            [0.2, 0.6, 0.7],
+            [0.4, 0.2, 0.7],
+        ],
+    };
+    let corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)];
+    let ids: Vec<u32> = corners
+        .iter()
+        .zip(palette)
+        .map(|(&(x, y), c)| mesh.add_point(Point::new(x, y), c))
+        .collect();
+    mesh.add_face(ids);
+}
+
+fn delete_points(mesh: &mut GradientMesh, points: &[u32]) -> Result<(), String> {
+    for &p in points {
+        point_mut(mesh, p)?;
+    }
+    let faces: Vec<u32> = (0..mesh.faces.len() as u32)
+        .filter(|&f| mesh.faces[f as usize].iter().any(|c| points.contains(c)))
+        .collect();
+    remove_faces_and_points(mesh, &faces, points)
+}
+
+fn delete_faces(mesh: &mut GradientMesh, faces: &[u32]) -> Result<(), String> {
+    if let Some(f) = faces.iter().find(|&&f| f as usize >= mesh.faces.len()) {
+        return Err(format!("there is no face {f}"));
+    }
+    remove_faces_and_points(mesh, faces, &[])
+}
+
+/// Removes `faces`, the points in `points`, and every point no face uses any more; numbers the
+/// rest in order and carries handles, edge tags and side colours over to the new numbers.
+fn remove_faces_and_points(
+    mesh: &mut GradientMesh,
+    faces: &[u32],
+    points: &[u32],
+) -> Result<(), String> {
+    if !mesh.edits.is_empty() {
+        return Err(
+            "this layer has multi-resolution edits, which name faces by number: remove them before deleting".into(),
+        );
+    }
+    let kept_faces: Vec<Vec<u32>> = (mesh.faces.iter().enumerate())
+        .filter(|(f, _)| !faces.contains(&(*f as u32)))
+        .map(|(_, corners)| corners.clone())
+        .collect();
+    let mut used = vec![false; mesh.points.len()];
+    for corner in kept_faces.iter().flatten() {
+        used[*corner as usize] = true;
+    }
+    for &p in points {
+        used[p as usize] = false;
+    }
+    let mut new_index = vec![u32::MAX; mesh.points.len()];
+    let mut next = 0u32;
+    for (p, &keep) in used.iter().enumerate() {
+        if keep {
+            new_index[p] = next;
+            next += 1;
+        }
+    }
+    let old_faces: Vec<usize> = (0..mesh.faces.len())
+        .filter(|f| !faces.contains(&(*f as u32)))
+        .collect();
+    let renumber = |p: u32| new_index[p as usize];
+    mesh.points = (mesh.points.iter().zip(&used))
+        .filter(|(_, &keep)| keep)
+        .map(|(p, _)| p.clone())
+        .collect();
+    mesh.faces = kept_faces
+        .into_iter()
+        .map(|corners| corners.into_iter().map(renumber).collect())
+        .collect();
+    let alive = |&(a, b): &(u32, u32)| used[a as usize] && used[b as usize];
+    mesh.handles = std::mem::take(&mut mesh.handles)
+        .into_iter()
+        .filter(|(key, _)| alive(key))
+        .map(|((a, b), h)| ((renumber(a), renumber(b)), h))
+        .collect();
+    mesh.edges = std::mem::take(&mut mesh.edges)
+        .into_iter()
+        .filter(|(key, _)| alive(key))
+        .map(|((a, b), t)| (gradmesh_edge_key(renumber(a), renumber(b)), t))
+        .collect();
+    mesh.wedges = std::mem::take(&mut mesh.wedges)
+        .into_iter()
+        .filter_map(|mut w| {
+            let face = old_faces.iter().position(|&f| f == w.face as usize)?;
+            if !used[w.point as usize] || w.handles.keys().any(|&n| !used[n as usize]) {
+                return None;
+            }
+            w.point = renumber(w.point);
+            w.face = face as u32;
+            w.handles = w
+                .handles
+                .into_iter()
+                .map(|(n, h)| (renumber(n), h))
+                .collect();
+            Some(w)
+        })
+        .collect();
+    Ok(())
+}
+
+fn set_refined_edit(
+    mesh: &mut GradientMesh,
+    address: gradmesh::VertexAddress,
+    colour: Option<[f64; 3]>,
+    opacity: Option<f64>,
+) -> Result<(), String> {
+    if colour.is_none() && opacity.is_none() {
+        mesh.remove_edit(&address);
+        return Ok(());
+    }
+    let mut edit = mesh.edit(&address).cloned().unwrap_or(Edit {
+        address,
+        colour: None,
+        opacity: None,
+        offset: None,
+    });
+    edit.colour = colour.map(gradmesh::ColourEdit::Set);
+    edit.opacity = opacity.map(gradmesh::OpacityEdit::Set);
+    mesh.set_edit(edit);
+    Ok(())
+}

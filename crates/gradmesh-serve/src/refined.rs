@@ -1,0 +1,86 @@
+//! The refined vertices of one control face at a level, with their addresses, for picking the
+//! vertex of a multi-resolution edit on the page.
+
+use gradmesh::{Edit, GradientMesh, Refinement, VertexAddress, MAX_EDIT_LEVEL};
+use serde::Serialize;
+
+/// The deepest level whose vertices the page can show (a sector then has 12 x 12 quads).
+pub const MAX_PICK_LEVEL: u32 = 4;
+
+/// One refined vertex: its address and its limit position.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RefinedVertex {
+    /// The control point at the corner of its sector.
+    pub point: u32,
+    /// Its coordinates in the sector's grid.
+    pub at: [u32; 2],
+    /// Its position on the limit surface.
+    pub position: [f64; 2],
+}
+
+/// Every vertex of the sectors of `face` at `level`, named through each sector (a vertex on a
+/// sector's side appears once per sector that names it). Positions are those of the limit
+/// surface without the layer's edits.
+pub fn face_vertices(
+    mesh: &GradientMesh,
+    face: u32,
+    level: u32,
+) -> Result<Vec<RefinedVertex>, String> {
+    if !(1..=MAX_PICK_LEVEL.min(MAX_EDIT_LEVEL)).contains(&level) {
+        return Err(format!("the level must be 1 to {MAX_PICK_LEVEL}"));
+    }
+    let corners = mesh
+        .faces
+        .get(face as usize)
+        .ok_or_else(|| format!("there is no face {face}"))?
+        .clone();
+    let mut plain = mesh.clone();
+    plain.edits.clear();
+    let (mut refinement, _) = Refinement::new(&plain, level as usize).map_err(|e| e.to_string())?;
+    let data = refinement.evaluate();
+    let limit = refinement.limit(&data, level as usize);
+    let size = VertexAddress::sector_size(level);
+    let mut vertices = Vec::new();
+    for &point in &corners {
+        for i in 0..=size {
+            for j in 0..=size {
+                let address = VertexAddress::new(level, face, point, [i, j]);
+                refinement
+                    .set_edits(&[Edit::new(address)], plain.fine_edits)
+                    .map_err(|e| e.to_string())?;
+                if let Some(v) = refinement.edited_vertex(0) {
+                    vertices.push(RefinedVertex {
+                        point,
+                        at: [i, j],
+                        position: [limit[v][0], limit[v][1]],
+                    });
+                }
+            }
+        }
+    }
+    Ok(vertices)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gradmesh::ColourSpace;
+    use kurbo::Point;
+
+    #[test]
+    fn a_quad_at_level_2_has_four_sectors_of_16_names() {
+        let mut mesh = GradientMesh::new(ColourSpace::Lab);
+        for (x, y) in [(0.0, 0.0), (90.0, 0.0), (90.0, 90.0), (0.0, 90.0)] {
+            mesh.add_point(Point::new(x, y), [50.0, 0.0, 0.0]);
+        }
+        mesh.add_face(vec![0, 1, 2, 3]);
+        let vertices = face_vertices(&mesh, 0, 2).unwrap();
+        assert_eq!(vertices.len(), 4 * 16);
+        // [3, 3] of every sector is the face's centre.
+        for v in vertices.iter().filter(|v| v.at == [3, 3]) {
+            assert!((v.position[0] - 45.0).abs() < 1e-9 && (v.position[1] - 45.0).abs() < 1e-9);
+        }
+        assert!(face_vertices(&mesh, 1, 2).is_err());
+        assert!(face_vertices(&mesh, 0, 9).is_err());
+    }
+}

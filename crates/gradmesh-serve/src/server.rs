@@ -1,0 +1,254 @@
+//! The HTTP routes and the WebSocket.
+
+use std::net::{Ipv4Addr, SocketAddr};
+use std::sync::Arc;
+
+use axum::body::Bytes;
+use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
+use axum::extract::{DefaultBodyLimit, Query, State};
+use axum::http::{header, StatusCode};
+use axum::response::{Html, IntoResponse, Response};
+use axum::routing::{get, post};
+use axum::Router;
+use futures_util::{SinkExt, StreamExt};
+use gradmesh::render::{self, RenderOptions};
+use tokio::net::TcpListener;
+use tokio::sync::mpsc;
+
+use crate::security::{guard, Gate};
+use crate::session::{App, Command, Outgoing, Session};
+
+/// The largest request body and WebSocket message accepted, in bytes.
+pub const MAX_BODY: usize = 1 << 20;
+
+/// The largest side of a downloaded PNG, in pixels.
+pub const PNG_SIDE: u32 = 2048;
+
+const INDEX_HTML: &str = include_str!("../assets/index.html");
+const APP_JS: &str = include_str!("../assets/app.js");
+const STYLE_CSS: &str = include_str!("../assets/style.css");
+
+/// The routes, each behind the gate.
+pub fn router(app: Arc<App>, gate: Gate) -> Router {
+    let token = gate.token.clone();
+    Router::new()
+        .route("/", get(move || index(token.clone())))
+        .route(
+            "/app.js",
+            get(|| asset(APP_JS, "text/javascript; charset=utf-8")),
+        )
+        .route(
+            "/style.css",
+            get(|| asset(STYLE_CSS, "text/css; charset=utf-8")),
+        )
+        .route("/api/state", get(state))
+        .route("/api/command", post(command))
+        .route("/api/files", get(files))
+        .route("/api/document.json", get(document_json))
+        .route("/api/picture.png", get(picture_png))
+        .route("/api/refined", get(refined_vertices))
+        .route("/ws", get(websocket))
+        .fallback(|| async { (StatusCode::NOT_FOUND, "no such page") })
+        .layer(DefaultBodyLimit::max(MAX_BODY))
+        .layer(axum::middleware::from_fn_with_state(gate, guard))
+        .with_state(app)
+}
+
+/// Binds to the loopback address at `port` (0: any free port).
+pub async fn bind_loopback(port: u16) -> std::io::Result<TcpListener> {
+    TcpListener::bind(SocketAddr::from((Ipv4Addr::LOCALHOST, port))).await
+}
+
+async fn index(token: String) -> Response {
+    let page = INDEX_HTML.replace("{{TOKEN}}", &token);
+    let mut response = Html(page).into_response();
+    let headers = response.headers_mut();
+    headers.insert(header::CACHE_CONTROL, "no-store".parse().expect("header"));
+    headers.insert(
+        header::CONTENT_SECURITY_POLICY,
+        "default-src 'self'; img-src 'self' blob: data:; connect-src 'self'; frame-ancestors 'none'"
+            .parse()
+            .expect("header"),
+    );
+    headers.insert(
+        header::REFERRER_POLICY,
+        "no-referrer".parse().expect("header"),
+    );
+    response
+}
+
+async fn asset(body: &'static str, kind: &'static str) -> Response {
+    ([(header::CONTENT_TYPE, kind)], body).into_response()
+}
+
+/// Runs commands on a blocking thread (they validate and render) with a session of its own.
+async fn run_blocking(app: Arc<App>, commands: Vec<Command>) -> Vec<Outgoing> {
+    tokio::task::spawn_blocking(move || Session::new(app).handle(&commands))
+        .await
+        .unwrap_or_default()
+}
+
+async fn state(State(app): State<Arc<App>>) -> Response {
+    reply(run_blocking(app, Vec::new()).await)
+}
+
+async fn command(State(app): State<Arc<App>>, body: Bytes) -> Response {
+    let command: Command = match serde_json::from_slice(&body) {
+        Ok(c) => c,
+        Err(e) => {
+            return (StatusCode::BAD_REQUEST, format!("malformed command: {e}")).into_response()
+        }
+    };
+    reply(run_blocking(app, vec![command]).await)
+}
+
+/// The answer of the HTTP API: the first error (422) or the state (200).
+fn reply(messages: Vec<Outgoing>) -> Response {
+    let mut state = None;
+    for message in messages {
+        match message {
+            Outgoing::Error(text) => {
+                return (
+                    StatusCode::UNPROCESSABLE_ENTITY,
+                    [(header::CONTENT_TYPE, "application/json")],
+                    text,
+                )
+                    .into_response();
+            }
+            Outgoing::Text(text) => state = Some(text),
+            Outgoing::Binary(_) | Outgoing::Done => {}
+        }
+    }
+    match state {
+        Some(text) => ([(header::CONTENT_TYPE, "application/json")], text).into_response(),
+        None => (StatusCode::INTERNAL_SERVER_ERROR, "no state").into_response(),
+    }
+}
+
+async fn files(State(app): State<Arc<App>>) -> Response {
+    let names = tokio::task::spawn_blocking(move || app.folder.documents())
+        .await
+        .unwrap_or_default();
+    axum::Json(names).into_response()
+}
+
+async fn document_json(State(app): State<Arc<App>>) -> Response {
+    let text = gradmesh::formats::json::write_document(&app.editor().history.current().doc);
+    ([(header::CONTENT_TYPE, "application/json")], text).into_response()
+}
+
+async fn picture_png(State(app): State<Arc<App>>) -> Response {
+    let doc = app.editor().history.current().visible();
+    let png = tokio::task::spawn_blocking(move || -> Result<Vec<u8>, String> {
+        let opts = RenderOptions::fit(&doc, PNG_SIDE);
+        let mut pixels = vec![0u8; 4 * opts.width as usize * opts.height as usize];
+        render::render_document_into(&doc, &opts, &mut pixels).map_err(|e| e.to_string())?;
+        render::encode_png_rgba8(opts.width, opts.height, &pixels).map_err(|e| e.to_string())
+    })
+    .await
+    .unwrap_or_else(|_| Err("the render failed".into()));
+    match png {
+        Ok(bytes) => (
+            [
+                (header::CONTENT_TYPE, "image/png"),
+                (
+                    header::CONTENT_DISPOSITION,
+                    "attachment; filename=\"picture.png\"",
+                ),
+            ],
+            bytes,
+        )
+            .into_response(),
+        Err(e) => (StatusCode::UNPROCESSABLE_ENTITY, e).into_response(),
+    }
+}
+
+/// Which refined vertices the page asks for.
+#[derive(serde::Deserialize)]
+struct RefinedQuery {
+    layer: usize,
+    face: u32,
+    level: u32,
+}
+
+async fn refined_vertices(State(app): State<Arc<App>>, Query(q): Query<RefinedQuery>) -> Response {
+    let mesh = app
+        .editor()
+        .history
+        .current()
+        .doc
+        .layers
+        .get(q.layer)
+        .cloned();
+    let Some(mesh) = mesh else {
+        return (
+            StatusCode::UNPROCESSABLE_ENTITY,
+            format!("there is no layer {}", q.layer),
+        )
+            .into_response();
+    };
+    let found =
+        tokio::task::spawn_blocking(move || crate::refined::face_vertices(&mesh, q.face, q.level))
+            .await
+            .unwrap_or_else(|_| Err("the refinement failed".into()));
+    match found {
+        Ok(vertices) => axum::Json(vertices).into_response(),
+        Err(e) => (StatusCode::UNPROCESSABLE_ENTITY, e).into_response(),
+    }
+}
+
+async fn websocket(State(app): State<Arc<App>>, upgrade: WebSocketUpgrade) -> Response {
+    upgrade
+        .max_message_size(MAX_BODY)
+        .max_frame_size(MAX_BODY)
+        .on_upgrade(move |socket| run_socket(socket, app))
+}
+
+/// Serves one page's WebSocket. A reader task queues the page's commands; the loop takes every
+/// command queued so far, runs them, and sends one frame for the lot. Commands that arrive
+/// while a frame renders wait for the next batch, so the page never gets a stale frame and
+/// rendering keeps up with the mouse however fast it moves.
+async fn run_socket(socket: WebSocket, app: Arc<App>) {
+    let (mut sink, mut stream) = socket.split();
+    let (queue, mut queued) = mpsc::unbounded_channel::<String>();
+    let reader = tokio::spawn(async move {
+        while let Some(Ok(message)) = stream.next().await {
+            match message {
+                Message::Text(text) if queue.send(text.to_string()).is_err() => break,
+                Message::Close(_) => break,
+                _ => {}
+            }
+        }
+    });
+    let mut session = Some(Session::new(app));
+    while let Some(first) = queued.recv().await {
+        let mut batch = vec![first];
+        while let Ok(next) = queued.try_recv() {
+            batch.push(next);
+        }
+        let mut running = session
+            .take()
+            .expect("the session is back after each batch");
+        let Ok((back, messages)) = tokio::task::spawn_blocking(move || {
+            let messages = running.handle_texts(&batch);
+            (running, messages)
+        })
+        .await
+        else {
+            break;
+        };
+        session = Some(back);
+        for message in messages {
+            let message = match message {
+                Outgoing::Text(text) | Outgoing::Error(text) => Message::Text(text.into()),
+                Outgoing::Binary(bytes) => Message::Binary(bytes.into()),
+                Outgoing::Done => Message::Text(r#"{"type":"done"}"#.into()),
+            };
+            if sink.send(message).await.is_err() {
+                reader.abort();
+                return;
+            }
+        }
+    }
+    reader.abort();
+}

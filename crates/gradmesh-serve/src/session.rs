@@ -1,0 +1,320 @@
+//! What the page asks for and what it gets back: commands in, state and frames out. The
+//! WebSocket and the HTTP API both go through [`Session::handle`].
+
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use gradmesh::render::View;
+use serde::Deserialize;
+
+use crate::editor::Editor;
+use crate::ops::Op;
+use crate::security::Folder;
+use crate::state::{FoldCache, Status};
+use crate::viewer::{Viewer, Viewport};
+
+/// The server's shared state: the document being edited and the folder it lives in.
+#[derive(Debug)]
+pub struct App {
+    /// The document.
+    pub editor: Mutex<Editor>,
+    /// The starting folder.
+    pub folder: Folder,
+}
+
+impl App {
+    /// The editor, even if a thread panicked while holding it (its data is whole: every edit
+    /// replaces the picture in one assignment).
+    pub fn editor(&self) -> MutexGuard<'_, Editor> {
+        self.editor.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+/// One request of the page.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Command {
+    /// An edit, part of a gesture if `gesture` is given.
+    Edit {
+        /// The edit.
+        op: Op,
+        /// The gesture it belongs to.
+        #[serde(default)]
+        gesture: Option<u64>,
+    },
+    /// Asks for the state (and a frame), changing nothing.
+    State,
+    /// Ends the open gesture.
+    EndGesture,
+    /// Undoes one step.
+    Undo,
+    /// Redoes one step.
+    Redo,
+    /// Sets the canvas size (device pixels) and the rectangle of the plane it shows.
+    View {
+        /// Width in pixels.
+        width: u32,
+        /// Height in pixels.
+        height: u32,
+        /// Left, top, right, bottom.
+        view: [f64; 4],
+    },
+    /// Saves to the document's file.
+    Save,
+    /// Saves to another JSON file in the starting folder.
+    SaveAs {
+        /// Its name relative to the folder.
+        name: String,
+    },
+    /// Opens a document of the starting folder.
+    Open {
+        /// Its name relative to the folder.
+        name: String,
+    },
+    /// Starts a new document.
+    New,
+}
+
+/// A message for the page.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Outgoing {
+    /// JSON: the state.
+    Text(String),
+    /// JSON: an error message.
+    Error(String),
+    /// A frame (see [`crate::viewer::encode_frame`]).
+    Binary(Vec<u8>),
+    /// The end of the answer to a batch of commands: the page may send the next batch.
+    Done,
+}
+
+/// One page's session: its viewer and what it was last told.
+pub struct Session {
+    app: Arc<App>,
+    viewer: Viewer,
+    /// The history version the page last got the state of, and whether a gesture was open.
+    told_version: Option<(u64, bool)>,
+    folds: FoldCache,
+}
+
+impl Session {
+    /// A session of `app`.
+    pub fn new(app: Arc<App>) -> Session {
+        Session {
+            app,
+            viewer: Viewer::new(),
+            told_version: None,
+            folds: FoldCache::default(),
+        }
+    }
+
+    /// The viewer (its last frame).
+    pub fn viewer(&self) -> &Viewer {
+        &self.viewer
+    }
+
+    /// Handles a batch of JSON commands: all of them in order, then one frame and one state
+    /// for the result. Messages that are not commands get an error message each.
+    pub fn handle_texts(&mut self, texts: &[String]) -> Vec<Outgoing> {
+        let mut out = Vec::new();
+        let mut commands = Vec::with_capacity(texts.len());
+        for text in texts {
+            match serde_json::from_str::<Command>(text) {
+                Ok(c) => commands.push(c),
+                Err(e) => out.push(error_message(&format!("malformed command: {e}"))),
+            }
+        }
+        out.extend(self.handle(&commands));
+        out
+    }
+
+    /// Handles commands in order, then renders once; returns the errors, the state if it
+    /// changed, and the frame if pixels changed.
+    pub fn handle(&mut self, commands: &[Command]) -> Vec<Outgoing> {
+        let mut out = Vec::new();
+        for command in commands {
+            if let Err(message) = self.run(command) {
+                out.push(error_message(&message));
+            }
+        }
+        let doc = self.app.editor().history.current().visible();
+        match self.viewer.render(&doc) {
+            Ok(Some(frame)) => out.push(Outgoing::Binary(frame)),
+            Ok(None) => {}
+            Err(e) => out.push(error_message(&format!("cannot render: {e}"))),
+        }
+        if let Some(status) = self.status_if_changed() {
+            out.push(Outgoing::Text(status));
+        }
+        out.push(Outgoing::Done);
+        out
+    }
+
+    /// The state message, if the picture changed since the page was last told. Folds are
+    /// looked for only when no gesture is open, and only in the layers that changed.
+    fn status_if_changed(&mut self) -> Option<String> {
+        let app = Arc::clone(&self.app);
+        let editor = app.editor();
+        let h = &editor.history;
+        let key = (h.version(), h.gesture_open());
+        if self.told_version == Some(key) {
+            return None;
+        }
+        let folds = (!key.1).then(|| self.folds.folds(&h.current().doc.layers));
+        let (can_undo, can_redo) = h.can_undo_redo();
+        let status = Status {
+            picture: h.current(),
+            file: editor.path.as_deref().map(|p| app.folder.name_of(p)),
+            modified: h.modified(),
+            can_undo,
+            can_redo,
+            folds,
+        };
+        self.told_version = Some(key);
+        Some(status.to_json().to_string())
+    }
+
+    /// Runs one command.
+    fn run(&mut self, command: &Command) -> Result<(), String> {
+        let app = Arc::clone(&self.app);
+        let mut editor = app.editor();
+        match command {
+            Command::Edit { op, gesture } => editor.history.apply(op, *gesture),
+            Command::State => Ok(()),
+            Command::EndGesture => {
+                editor.history.end_gesture();
+                Ok(())
+            }
+            Command::Undo => {
+                editor.history.undo();
+                Ok(())
+            }
+            Command::Redo => {
+                editor.history.redo();
+                Ok(())
+            }
+            Command::View {
+                width,
+                height,
+                view,
+            } => {
+                let [x0, y0, x1, y1] = *view;
+                self.viewer.set_viewport(Viewport {
+                    width: *width,
+                    height: *height,
+                    view: View::new(x0, y0, x1, y1),
+                })
+            }
+            Command::Save => match editor.path.clone() {
+                Some(path) => editor.save_to(&path),
+                None => Err("this document has no file yet: use Save as".into()),
+            },
+            Command::SaveAs { name } => {
+                let path = app.folder.resolve(name)?;
+                editor.save_to(&path)
+            }
+            Command::Open { name } => {
+                let path = app.folder.resolve(name)?;
+                *editor = Editor::open(&path)?;
+                self.told_version = None;
+                Ok(())
+            }
+            Command::New => {
+                *editor = Editor::new_document();
+                self.told_version = None;
+                Ok(())
+            }
+        }
+    }
+}
+
+/// An error message for the page.
+pub fn error_message(message: &str) -> Outgoing {
+    Outgoing::Error(serde_json::json!({"type": "error", "message": message}).to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::editor::History;
+    use crate::ops::Picture;
+
+    fn square_session() -> Session {
+        let mut picture = Picture::default();
+        Op::AddLayer { name: None }.apply(&mut picture).unwrap();
+        Op::AddRectangle {
+            layer: 0,
+            rect: [0.0, 0.0, 100.0, 100.0],
+        }
+        .apply(&mut picture)
+        .unwrap();
+        let app = App {
+            editor: Mutex::new(Editor {
+                history: History::new(picture),
+                path: None,
+            }),
+            folder: Folder::new(&std::env::temp_dir()).unwrap(),
+        };
+        Session::new(Arc::new(app))
+    }
+
+    fn count(out: &[Outgoing]) -> (usize, usize, usize, usize) {
+        let mut n = (0, 0, 0, 0);
+        for message in out {
+            match message {
+                Outgoing::Binary(_) => n.0 += 1,
+                Outgoing::Text(_) => n.1 += 1,
+                Outgoing::Error(_) => n.2 += 1,
+                Outgoing::Done => n.3 += 1,
+            }
+        }
+        n
+    }
+
+    #[test]
+    fn a_batch_of_drag_moves_gives_one_frame_of_the_last() {
+        let mut session = square_session();
+        let view = r#"{"type":"view","width":200,"height":200,"view":[-10,-10,110,110]}"#;
+        assert_eq!(
+            count(&session.handle_texts(&[view.to_string()])),
+            (1, 1, 0, 1)
+        );
+        let moves: Vec<String> = (1..=20)
+            .map(|dx| {
+                format!(
+                    r#"{{"type":"edit","gesture":3,"op":{{"op":"move_points","layer":0,"points":[0],"dx":{dx},"dy":0}}}}"#
+                )
+            })
+            .collect();
+        assert_eq!(count(&session.handle_texts(&moves)), (1, 1, 0, 1));
+        let editor = session.app.editor();
+        assert_eq!(
+            editor.history.current().doc.layers[0].points[0].position.x,
+            20.0
+        );
+        drop(editor);
+        // One undo step takes the whole drag back.
+        session.handle_texts(&[r#"{"type":"undo"}"#.to_string()]);
+        let editor = session.app.editor();
+        assert_eq!(
+            editor.history.current().doc.layers[0].points[0].position.x,
+            0.0
+        );
+        assert!(!editor.history.can_undo_redo().0);
+    }
+
+    #[test]
+    fn nothing_changed_gives_no_frame_and_bad_commands_an_error_each() {
+        let mut session = square_session();
+        let view = r#"{"type":"view","width":64,"height":64,"view":[0,0,100,100]}"#;
+        session.handle_texts(&[view.to_string()]);
+        assert_eq!(
+            count(&session.handle_texts(&[r#"{"type":"state"}"#.to_string()])),
+            (0, 0, 0, 1)
+        );
+        let bad = [
+            "{".to_string(),
+            r#"{"type":"view","width":0,"height":1,"view":[0,0,1,1]}"#.to_string(),
+        ];
+        assert_eq!(count(&session.handle_texts(&bad)), (0, 0, 2, 1));
+    }
+}

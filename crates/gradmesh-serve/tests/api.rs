@@ -1,0 +1,392 @@
+//! The server's API without a browser: the token, `Host` and `Origin` checks, the folder's
+//! bounds, body limits, malformed requests, saving, and a page that goes away mid-edit.
+
+use std::path::Path;
+
+use futures_util::{SinkExt, StreamExt};
+use gradmesh_serve::{start, Config, Running};
+use tokio::io::{AsyncReadExt, AsyncWriteExt};
+use tokio::net::TcpStream;
+use tokio_tungstenite::tungstenite::client::IntoClientRequest;
+use tokio_tungstenite::tungstenite::Message;
+
+const SQUARE: &str = r##"{"format":"gradmesh","version":1,"layers":[{"name":"square","points":[
+  {"position":[0,0],"colour":"#d04020"},{"position":[100,0],"colour":"#e0c030"},
+  {"position":[100,100],"colour":"#2060c0"},{"position":[0,100],"colour":"#40a040"}],
+  "faces":[[0,1,2,3]]}]}"##;
+
+/// A server on a folder holding `square.json`.
+async fn serve_square() -> (Running, tempfile::TempDir) {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("square.json");
+    std::fs::write(&file, SQUARE).unwrap();
+    gradmesh::formats::read_path(&file).expect("the test document reads");
+    let running = start(&Config {
+        file: Some(file),
+        folder: None,
+        port: 0,
+    })
+    .await
+    .unwrap();
+    (running, dir)
+}
+
+/// Sends one HTTP/1.1 request with exactly the headers given (and `Content-Length`); returns
+/// the status code and the body.
+async fn request(
+    running: &Running,
+    method: &str,
+    target: &str,
+    headers: &[(&str, &str)],
+    body: &[u8],
+) -> (u16, String) {
+    let mut stream = TcpStream::connect(running.address).await.unwrap();
+    let mut head = format!("{method} {target} HTTP/1.1\r\nConnection: close\r\n");
+    for (name, value) in headers {
+        head.push_str(&format!("{name}: {value}\r\n"));
+    }
+    head.push_str(&format!("Content-Length: {}\r\n\r\n", body.len()));
+    stream.write_all(head.as_bytes()).await.unwrap();
+    // A server may answer (413) before reading a large body, and close.
+    let _ = stream.write_all(body).await;
+    let mut answer = Vec::new();
+    let _ = stream.read_to_end(&mut answer).await;
+    let text = String::from_utf8_lossy(&answer).to_string();
+    let status = text
+        .split(' ')
+        .nth(1)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no HTTP answer: {text:?}"));
+    let body = text.split_once("\r\n\r\n").map(|(_, b)| b.to_string());
+    (status, body.unwrap_or_default())
+}
+
+fn host(running: &Running) -> String {
+    format!("127.0.0.1:{}", running.address.port())
+}
+
+async fn get(running: &Running, target: &str) -> (u16, String) {
+    request(running, "GET", target, &[("Host", &host(running))], b"").await
+}
+
+async fn command(running: &Running, json: &str) -> (u16, String) {
+    let target = format!("/api/command?token={}", running.token);
+    let headers = [
+        ("Host", host(running)),
+        ("Content-Type", "application/json".to_string()),
+    ];
+    let headers: Vec<(&str, &str)> = headers.iter().map(|(n, v)| (*n, v.as_str())).collect();
+    request(running, "POST", &target, &headers, json.as_bytes()).await
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn listens_on_loopback_only() {
+    let (running, _dir) = serve_square().await;
+    assert!(running.address.ip().is_loopback(), "{}", running.address);
+    assert!(running.url().starts_with("http://127.0.0.1:"));
+    assert!(running.url().ends_with(&running.token));
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn every_route_needs_the_token() {
+    let (running, _dir) = serve_square().await;
+    let token = &running.token;
+    let wrong = "0".repeat(token.len());
+    for route in [
+        "/",
+        "/app.js",
+        "/style.css",
+        "/api/state",
+        "/api/files",
+        "/api/picture.png",
+    ] {
+        let (status, body) = get(&running, route).await;
+        assert_eq!(status, 401, "{route} without a token: {body}");
+        assert!(body.contains("token"), "{body}");
+        let join = if route.contains('?') { '&' } else { '?' };
+        let (status, _) = get(&running, &format!("{route}{join}token={wrong}")).await;
+        assert_eq!(status, 401, "{route} with a wrong token");
+        let (status, _) = get(&running, &format!("{route}{join}token={token}")).await;
+        assert_eq!(status, 200, "{route} with the token");
+    }
+    let (status, page) = get(&running, &format!("/?token={token}")).await;
+    assert_eq!(status, 200);
+    assert!(page.contains(&format!("/app.js?token={token}")));
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn foreign_host_and_origin_are_refused() {
+    let (running, _dir) = serve_square().await;
+    let target = format!("/api/state?token={}", running.token);
+    let port = running.address.port();
+    let rebinding = format!("attacker.example:{port}");
+    let (status, body) = request(&running, "GET", &target, &[("Host", &rebinding)], b"").await;
+    assert_eq!(status, 403, "{body}");
+    assert!(body.contains("Host"), "{body}");
+    let (status, _) = request(&running, "GET", &target, &[], b"").await;
+    assert_eq!(status, 403, "no Host header");
+    let good_host = host(&running);
+    for origin in ["http://attacker.example", "null", "https://127.0.0.1:1"] {
+        let headers = [("Host", good_host.as_str()), ("Origin", origin)];
+        let (status, body) = request(&running, "GET", &target, &headers, b"").await;
+        assert_eq!(status, 403, "{origin}: {body}");
+    }
+    let own = format!("http://localhost:{port}");
+    let headers = [("Host", good_host.as_str()), ("Origin", own.as_str())];
+    assert_eq!(
+        request(&running, "GET", &target, &headers, b"").await.0,
+        200
+    );
+}
+
+/// Opens the WebSocket with the given token and origin; the HTTP status if refused.
+async fn open_socket(
+    running: &Running,
+    token: &str,
+    origin: &str,
+) -> Result<tokio_tungstenite::WebSocketStream<tokio_tungstenite::MaybeTlsStream<TcpStream>>, u16> {
+    let url = format!("ws://{}/ws?token={token}", running.address);
+    let mut request = url.into_client_request().unwrap();
+    request
+        .headers_mut()
+        .insert("Origin", origin.parse().unwrap());
+    match tokio_tungstenite::connect_async(request).await {
+        Ok((socket, _)) => Ok(socket),
+        Err(tokio_tungstenite::tungstenite::Error::Http(response)) => {
+            Err(response.status().as_u16())
+        }
+        Err(e) => panic!("WebSocket: {e}"),
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_websocket_needs_the_token_and_origin() {
+    let (running, _dir) = serve_square().await;
+    let own = format!("http://127.0.0.1:{}", running.address.port());
+    assert_eq!(open_socket(&running, "nope", &own).await.err(), Some(401));
+    let foreign = open_socket(&running, &running.token, "http://attacker.example").await;
+    assert_eq!(foreign.err(), Some(403));
+    assert!(open_socket(&running, &running.token, &own).await.is_ok());
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn nothing_outside_the_folder_is_read_or_written() {
+    let (running, dir) = serve_square().await;
+    let outside = tempfile::tempdir().unwrap();
+    std::fs::write(outside.path().join("secret.json"), SQUARE).unwrap();
+    std::os::unix::fs::symlink(outside.path(), dir.path().join("link")).unwrap();
+    std::os::unix::fs::symlink(
+        outside.path().join("secret.json"),
+        dir.path().join("secret.json"),
+    )
+    .unwrap();
+    let secret = outside.path().join("secret.json");
+    let names = [
+        "../secret.json".to_string(),
+        secret.display().to_string(),
+        "link/secret.json".to_string(),
+        "secret.json".to_string(),
+        "link/new.json".to_string(),
+    ];
+    for name in &names {
+        let (status, body) =
+            command(&running, &format!(r#"{{"type":"open","name":{name:?}}}"#)).await;
+        assert!((400..500).contains(&status), "open {name}: {status} {body}");
+        assert!(body.contains("refused"), "{body}");
+        let (status, body) = command(
+            &running,
+            &format!(r#"{{"type":"save_as","name":{name:?}}}"#),
+        )
+        .await;
+        assert!(
+            (400..500).contains(&status),
+            "save as {name}: {status} {body}"
+        );
+    }
+    assert_eq!(std::fs::read_to_string(&secret).unwrap(), SQUARE);
+    assert!(!outside.path().join("new.json").exists());
+    let (status, _) = get(
+        &running,
+        &format!("/../secret.json?token={}", running.token),
+    )
+    .await;
+    assert_eq!(status, 404);
+    let (status, files) = get(&running, &format!("/api/files?token={}", running.token)).await;
+    assert_eq!((status, files.as_str()), (200, r#"["square.json"]"#));
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn large_and_malformed_requests_get_4xx_with_a_message() {
+    let (running, _dir) = serve_square().await;
+    let big = format!(r#"{{"type":"open","name":"{}"}}"#, "a".repeat(2 << 20));
+    let (status, _) = command(&running, &big).await;
+    assert_eq!(status, 413);
+    for (json, expected) in [
+        ("{", 400),
+        (r#"{"type":"fly"}"#, 400),
+        (
+            r#"{"type":"edit","op":{"op":"move_points","layer":0}}"#,
+            400,
+        ),
+        (
+            r#"{"type":"edit","op":{"op":"move_points","layer":7,"points":[0],"dx":1,"dy":1}}"#,
+            422,
+        ),
+        (
+            r#"{"type":"edit","op":{"op":"move_points","layer":0,"points":[99],"dx":1,"dy":1}}"#,
+            422,
+        ),
+        (
+            r#"{"type":"edit","op":{"op":"add_face","layer":0,"points":[0,1]}}"#,
+            422,
+        ),
+        (
+            r#"{"type":"edit","op":{"op":"set_colour","layer":0,"points":[0],"css":"no colour"}}"#,
+            422,
+        ),
+        (r#"{"type":"save_as","name":"square.txt"}"#, 422),
+    ] {
+        let (status, body) = command(&running, json).await;
+        assert_eq!(status, expected, "{json}: {body}");
+        assert!(!body.is_empty());
+    }
+    // Nothing was changed, and the server still answers.
+    let (status, state) = get(&running, &format!("/api/state?token={}", running.token)).await;
+    assert_eq!(status, 200);
+    assert!(state.contains(r#""can_undo":false"#), "{state}");
+}
+
+fn read_x0(path: &Path) -> f64 {
+    let doc = gradmesh::formats::read_path(path).unwrap();
+    doc.layers[0].points[0].position.x
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn saving_is_whole_and_a_page_leaving_mid_edit_loses_nothing_saved() {
+    let (running, dir) = serve_square().await;
+    let file = dir.path().join("square.json");
+    let edit = r#"{"type":"edit","op":{"op":"move_points","layer":0,"points":[0],"dx":5,"dy":0}}"#;
+    assert_eq!(command(&running, edit).await.0, 200);
+    assert_eq!(command(&running, r#"{"type":"save"}"#).await.0, 200);
+    assert_eq!(read_x0(&file), 5.0);
+
+    // A page sends a view and a drag, and goes away without reading the answers.
+    let own = format!("http://127.0.0.1:{}", running.address.port());
+    let mut socket = open_socket(&running, &running.token, &own).await.unwrap();
+    let view = r#"{"type":"view","width":300,"height":300,"view":[-10,-10,110,110]}"#;
+    let drag = r#"{"type":"edit","gesture":9,"op":{"op":"move_points","layer":0,"points":[0],"dx":20,"dy":0}}"#;
+    for text in [view, drag, drag] {
+        socket.send(Message::Text(text.into())).await.unwrap();
+    }
+    drop(socket);
+    // What the server received before the connection closed is applied (what was still in
+    // flight may be lost with the connection); the saved file stays whole and as saved.
+    tokio::time::sleep(std::time::Duration::from_millis(300)).await;
+    assert_eq!(read_x0(&file), 5.0);
+    let mut socket = open_socket(&running, &running.token, &own).await.unwrap();
+    socket
+        .send(Message::Text(r#"{"type":"state"}"#.into()))
+        .await
+        .unwrap();
+    let mut got_state = false;
+    while let Some(Ok(message)) = socket.next().await {
+        match message {
+            Message::Text(text) if text.contains(r#""type":"state""#) => got_state = true,
+            Message::Text(text) if text.contains(r#""type":"done""#) => break,
+            _ => {}
+        }
+    }
+    assert!(got_state);
+    let state = get(&running, &format!("/api/state?token={}", running.token))
+        .await
+        .1;
+    let x_now = if state.contains("[25.0,0.0]") {
+        25.0
+    } else {
+        5.0
+    };
+    assert_eq!(read_x0(&file), 5.0);
+    assert_eq!(command(&running, r#"{"type":"save"}"#).await.0, 200);
+    assert_eq!(read_x0(&file), x_now);
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .collect();
+    assert_eq!(
+        names,
+        vec!["square.json".to_string()],
+        "no temporary files left"
+    );
+    // Save as: a new file in the folder; "save" then writes it.
+    assert_eq!(
+        command(&running, r#"{"type":"save_as","name":"copy.json"}"#)
+            .await
+            .0,
+        200
+    );
+    assert_eq!(read_x0(&dir.path().join("copy.json")), x_now);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_new_document_is_drawn_and_saved_as() {
+    let dir = tempfile::tempdir().unwrap();
+    let running = start(&Config {
+        file: None,
+        folder: Some(dir.path().to_path_buf()),
+        port: 0,
+    })
+    .await
+    .unwrap();
+    let rectangle = r#"{"type":"edit","op":{"op":"add_rectangle","layer":0,"rect":[0,0,40,30]}}"#;
+    assert_eq!(command(&running, rectangle).await.0, 200);
+    let (status, body) = command(&running, r#"{"type":"save"}"#).await;
+    assert_eq!(status, 422, "{body}");
+    assert!(body.contains("Save as"), "{body}");
+    let (status, _) = command(&running, r#"{"type":"save_as","name":"new.json"}"#).await;
+    assert_eq!(status, 200);
+    let doc = gradmesh::formats::read_path(&dir.path().join("new.json")).unwrap();
+    assert_eq!(
+        (doc.layers[0].points.len(), doc.layers[0].faces.len()),
+        (4, 1)
+    );
+    let (status, png) = get(
+        &running,
+        &format!("/api/picture.png?token={}", running.token),
+    )
+    .await;
+    assert_eq!(status, 200);
+    assert!(png.contains("PNG"));
+    // Open another document of the folder: a copy of the example with its creases.
+    let example =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/edge-kinds.json");
+    std::fs::copy(example, dir.path().join("edges.json")).unwrap();
+    let (status, state) = command(&running, r#"{"type":"open","name":"edges.json"}"#).await;
+    assert_eq!(status, 200, "{state}");
+    assert!(state.contains(r#""file":"edges.json""#), "{state}");
+    assert!(state.contains(r#""crease""#), "{state}");
+    assert!(state.contains(r#""can_undo":false"#), "{state}");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_oversized_websocket_message_closes_only_that_connection() {
+    let (running, _dir) = serve_square().await;
+    let own = format!("http://127.0.0.1:{}", running.address.port());
+    let mut socket = open_socket(&running, &running.token, &own).await.unwrap();
+    let huge = format!(r#"{{"type":"open","name":"{}"}}"#, "a".repeat(2 << 20));
+    let _ = socket.send(Message::Text(huge.into())).await;
+    // The server ends the connection: the stream closes (or errs) instead of waiting.
+    let ended = tokio::time::timeout(std::time::Duration::from_secs(10), async {
+        while let Some(Ok(message)) = socket.next().await {
+            if let Message::Close(_) = message {
+                break;
+            }
+        }
+    })
+    .await;
+    assert!(
+        ended.is_ok(),
+        "the connection stays open after an oversized message"
+    );
+    let (status, _) = get(&running, &format!("/api/state?token={}", running.token)).await;
+    assert_eq!(status, 200, "the server goes on");
+}

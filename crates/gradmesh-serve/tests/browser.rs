@@ -1,0 +1,623 @@
+//! The editor in a real browser: Debian's headless Chromium driven through chromedriver
+//! (WebDriver). Loads a document, drags a point with mouse events, changes a colour, toggles a
+//! crease, makes a multi-resolution colour edit, undoes, saves, and compares the canvas with
+//! gradmesh's own render of the saved file. Fails (never skips) when Chromium or chromedriver
+//! is missing: `.ci/run` installs them.
+//!
+//! Screenshots go to `target/editor-screenshots/`; with `GRADMESH_UPDATE_SCREENSHOTS=1` they
+//! are also copied to `docs/editor.png` and `docs/editor-edited.png`.
+
+use std::net::TcpListener;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use fantoccini::actions::{InputSource, MouseActions, PointerAction, MOUSE_BUTTON_LEFT};
+use fantoccini::{Client, ClientBuilder, Locator};
+use gradmesh::render::{self, RenderOptions, View};
+use gradmesh_serve::{start, Config, Running};
+use hyper_util::client::legacy::connect::HttpConnector;
+use serde_json::{json, Value};
+
+const WINDOW: (u32, u32) = (1280, 900);
+
+/// `name` on the `PATH`, or a clear failure.
+fn program(names: &[&str]) -> PathBuf {
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    for dir in std::env::split_paths(&path) {
+        for name in names {
+            let candidate = dir.join(name);
+            if candidate.is_file() {
+                return candidate;
+            }
+        }
+    }
+    panic!(
+        "the browser tests need {} on the PATH (Debian: apt-get install chromium chromium-driver)",
+        names.join(" or ")
+    );
+}
+
+/// chromedriver on a free loopback port, ended when dropped.
+struct Driver {
+    child: Child,
+    url: String,
+}
+
+impl Drop for Driver {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn start_driver() -> Driver {
+    let binary = program(&["chromedriver"]);
+    let port = TcpListener::bind("127.0.0.1:0")
+        .and_then(|l| l.local_addr())
+        .expect("a free port")
+        .port();
+    let child = Command::new(binary)
+        .arg(format!("--port={port}"))
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("chromedriver starts");
+    let url = format!("http://127.0.0.1:{port}");
+    let deadline = Instant::now() + Duration::from_secs(20);
+    while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+        assert!(
+            Instant::now() < deadline,
+            "chromedriver did not listen on {url}"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    Driver { child, url }
+}
+
+async fn open_browser(driver: &Driver) -> Client {
+    let chromium = program(&["chromium", "chromium-browser"]);
+    let mut caps = serde_json::Map::new();
+    caps.insert(
+        "goog:chromeOptions".into(),
+        json!({
+            "binary": chromium,
+            "args": [
+                "--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                format!("--window-size={},{}", WINDOW.0, WINDOW.1),
+                "--force-device-scale-factor=1",
+            ],
+        }),
+    );
+    ClientBuilder::new(HttpConnector::new())
+        .capabilities(caps)
+        .connect(&driver.url)
+        .await
+        .expect("a Chromium session through chromedriver")
+}
+
+async fn js(client: &Client, script: &str) -> Value {
+    client
+        .execute(script, vec![])
+        .await
+        .unwrap_or_else(|e| panic!("script failed: {e}\n{script}"))
+}
+
+/// Waits until the page has its state and a frame, and nothing is out or waiting.
+async fn settle(client: &Client) {
+    let deadline = Instant::now() + Duration::from_secs(30);
+    loop {
+        let ready = js(
+            client,
+            "const g = window.gradmesh; return !!g && g.state !== null && g.framesReceived > 0 \
+             && !g.busy && g.pending.length === 0;",
+        )
+        .await;
+        if ready == json!(true) {
+            // Each answer ends with "done", after its frame and state: all has arrived.
+            return;
+        }
+        assert!(Instant::now() < deadline, "the page did not settle");
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+}
+
+/// The picture canvas's pixels (RGBA8), width and height.
+async fn canvas_pixels(client: &Client) -> (u32, u32, Vec<u8>) {
+    let data = js(
+        client,
+        "const c = document.getElementById('picture'); \
+         const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data; \
+         let s = ''; for (let i = 0; i < d.length; i += 8192) \
+           s += String.fromCharCode.apply(null, d.subarray(i, i + 8192)); \
+         return [c.width, c.height, btoa(s)];",
+    )
+    .await;
+    let (w, h) = (
+        data[0].as_u64().unwrap() as u32,
+        data[1].as_u64().unwrap() as u32,
+    );
+    let bytes = decode_base64(data[2].as_str().unwrap());
+    assert_eq!(bytes.len(), 4 * w as usize * h as usize);
+    (w, h, bytes)
+}
+
+fn decode_base64(text: &str) -> Vec<u8> {
+    let value = |c: u8| -> u32 {
+        match c {
+            b'A'..=b'Z' => (c - b'A') as u32,
+            b'a'..=b'z' => (c - b'a' + 26) as u32,
+            b'0'..=b'9' => (c - b'0' + 52) as u32,
+            b'+' => 62,
+            b'/' => 63,
+            _ => panic!("not base64: {c}"),
+        }
+    };
+    let mut out = Vec::with_capacity(text.len() / 4 * 3);
+    for chunk in text.as_bytes().chunks(4) {
+        let pad = chunk.iter().filter(|&&c| c == b'=').count();
+        let n = chunk
+            .iter()
+            .take(4 - pad)
+            .fold(0u32, |acc, &c| (acc << 6) | value(c))
+            << (6 * pad);
+        let bytes = [(n >> 16) as u8, (n >> 8) as u8, n as u8];
+        out.extend_from_slice(&bytes[..3 - pad]);
+    }
+    out
+}
+
+/// The screen position (viewport pixels) of point `p` of layer 0.
+async fn point_on_screen(client: &Client, p: usize) -> (f64, f64) {
+    let at = js(
+        client,
+        &format!(
+            "const g = window.gradmesh; const [x, y] = g.toScreen(...g.state.layers[0].points[{p}]); \
+             const r = document.getElementById('overlay').getBoundingClientRect(); \
+             return [r.left + x, r.top + y];"
+        ),
+    )
+    .await;
+    (at[0].as_f64().unwrap(), at[1].as_f64().unwrap())
+}
+
+async fn drag(client: &Client, from: (f64, f64), by: (f64, f64)) {
+    let mut mouse = MouseActions::new("mouse".into())
+        .then(PointerAction::MoveTo {
+            duration: None,
+            x: from.0.round(),
+            y: from.1.round(),
+        })
+        .then(PointerAction::Down {
+            button: MOUSE_BUTTON_LEFT,
+        });
+    for _ in 0..10 {
+        mouse = mouse.then(PointerAction::MoveBy {
+            duration: Some(Duration::from_millis(20)),
+            x: by.0 / 10.0,
+            y: by.1 / 10.0,
+        });
+    }
+    mouse = mouse.then(PointerAction::Up {
+        button: MOUSE_BUTTON_LEFT,
+    });
+    client.perform_actions(mouse).await.expect("mouse drag");
+}
+
+async fn click(client: &Client, at: (f64, f64)) {
+    let mouse = MouseActions::new("mouse".into())
+        .then(PointerAction::MoveTo {
+            duration: None,
+            x: at.0.round(),
+            y: at.1.round(),
+        })
+        .then(PointerAction::Down {
+            button: MOUSE_BUTTON_LEFT,
+        })
+        .then(PointerAction::Up {
+            button: MOUSE_BUTTON_LEFT,
+        });
+    client.perform_actions(mouse).await.expect("mouse click");
+}
+
+async fn screenshot(client: &Client, name: &str) {
+    let png = client.screenshot().await.expect("a screenshot");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let dir = root.join("target/editor-screenshots");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join(name), &png).unwrap();
+    if std::env::var_os("GRADMESH_UPDATE_SCREENSHOTS").is_some() {
+        std::fs::write(root.join("docs").join(name), &png).unwrap();
+    }
+}
+
+async fn click_id(client: &Client, id: &str) -> Result<(), String> {
+    let element = client
+        .find(Locator::Id(id))
+        .await
+        .map_err(|e| e.to_string())?;
+    element.click().await.map_err(|e| e.to_string())
+}
+
+async fn type_into(client: &Client, id: &str, text: &str) -> Result<(), String> {
+    let element = client
+        .find(Locator::Id(id))
+        .await
+        .map_err(|e| e.to_string())?;
+    element.clear().await.map_err(|e| e.to_string())?;
+    element.send_keys(text).await.map_err(|e| e.to_string())
+}
+
+/// How many pixels differ between two images of the same size.
+fn differing_pixels(a: &[u8], b: &[u8]) -> usize {
+    a.chunks_exact(4)
+        .zip(b.chunks_exact(4))
+        .filter(|(p, q)| p != q)
+        .count()
+}
+
+/// Compares the canvas with gradmesh's render of `file` in the page's view: pixels drawn
+/// opaque must agree within 2 levels per channel (the canvas stores premultiplied colour);
+/// returns the largest difference.
+async fn compare_with_render(client: &Client, file: &Path, canvas: &(u32, u32, Vec<u8>)) -> u8 {
+    let view = js(
+        client,
+        "const v = window.gradmesh.view; return [v.x0, v.y0, v.x1, v.y1];",
+    )
+    .await;
+    let v: Vec<f64> = (0..4).map(|i| view[i].as_f64().unwrap()).collect();
+    let doc = gradmesh::formats::read_path(file).expect("the saved file reads");
+    let (w, h, pixels) = canvas;
+    let opts = RenderOptions::new(*w, *h, View::new(v[0], v[1], v[2], v[3]));
+    let mut expected = vec![0u8; pixels.len()];
+    render::render_document_into(&doc, &opts, &mut expected).expect("the saved file renders");
+    let mut worst = 0u8;
+    for (p, q) in pixels.chunks_exact(4).zip(expected.chunks_exact(4)) {
+        if q[3] == 255 {
+            for c in 0..4 {
+                worst = worst.max(p[c].abs_diff(q[c]));
+            }
+        } else {
+            worst = worst.max(p[3].abs_diff(q[3]));
+        }
+    }
+    worst
+}
+
+fn copy_example(dir: &Path) -> PathBuf {
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/edge-kinds.json");
+    let file = dir.join("edge-kinds.json");
+    std::fs::copy(example, &file).expect("the example document");
+    file
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn edit_in_a_real_browser() {
+    let driver = start_driver();
+    let dir = tempfile::tempdir().unwrap();
+    let file = copy_example(dir.path());
+    let running = start(&Config {
+        file: Some(file.clone()),
+        folder: None,
+        port: 0,
+    })
+    .await
+    .unwrap();
+    let client = open_browser(&driver).await;
+    let result = run_session(&client, &running, &file).await;
+    client.close().await.ok();
+    result.expect("the browser session");
+}
+
+async fn run_session(client: &Client, running: &Running, file: &Path) -> Result<(), String> {
+    client
+        .goto(&running.url())
+        .await
+        .map_err(|e| e.to_string())?;
+    settle(client).await;
+    let initial = canvas_pixels(client).await;
+    assert!(
+        initial.2.chunks_exact(4).filter(|p| p[3] == 255).count() > 10_000,
+        "the canvas shows the picture"
+    );
+    screenshot(client, "editor.png").await;
+
+    // Drag interior point 7 by (60, 40) pixels.
+    let before = js(client, "return window.gradmesh.state.layers[0].points[7];").await;
+    let from = point_on_screen(client, 7).await;
+    drag(client, from, (60.0, 40.0)).await;
+    settle(client).await;
+    let after = js(client, "return window.gradmesh.state.layers[0].points[7];").await;
+    let scale = js(client, "const g = window.gradmesh; return document.getElementById('overlay').getBoundingClientRect().width / (g.view.x1 - g.view.x0);").await.as_f64().unwrap();
+    let moved = (
+        (after[0].as_f64().unwrap() - before[0].as_f64().unwrap()) * scale,
+        (after[1].as_f64().unwrap() - before[1].as_f64().unwrap()) * scale,
+    );
+    assert!(
+        (moved.0 - 60.0).abs() < 2.0 && (moved.1 - 40.0).abs() < 2.0,
+        "the point moved by {moved:?} pixels, not (60, 40)"
+    );
+    let dragged = canvas_pixels(client).await;
+    let changed = differing_pixels(&initial.2, &dragged.2);
+    assert!(changed > 1000, "the drag changed only {changed} pixels");
+    let undo_steps = js(client, "return window.gradmesh.state.can_undo;").await;
+    assert_eq!(undo_steps, json!(true));
+
+    // Undo restores the pixels exactly; redo brings the drag back.
+    client
+        .find(Locator::Id("undo"))
+        .await
+        .map_err(|e| e.to_string())?
+        .click()
+        .await
+        .map_err(|e| e.to_string())?;
+    settle(client).await;
+    let undone = canvas_pixels(client).await;
+    assert_eq!(
+        differing_pixels(&initial.2, &undone.2),
+        0,
+        "undo restores the picture"
+    );
+    client
+        .find(Locator::Id("redo"))
+        .await
+        .map_err(|e| e.to_string())?
+        .click()
+        .await
+        .map_err(|e| e.to_string())?;
+    settle(client).await;
+    assert_eq!(
+        differing_pixels(&dragged.2, &canvas_pixels(client).await.2),
+        0
+    );
+
+    // Select point 7 and set its colour by hex.
+    click(client, point_on_screen(client, 7).await).await;
+    settle(client).await;
+    let hex = client
+        .find(Locator::Id("colour-hex"))
+        .await
+        .map_err(|e| e.to_string())?;
+    hex.clear().await.map_err(|e| e.to_string())?;
+    hex.send_keys("#ff00ff\n")
+        .await
+        .map_err(|e| e.to_string())?;
+    settle(client).await;
+    let colour = js(client, "return window.gradmesh.state.layers[0].hex[7];").await;
+    assert_eq!(colour, json!("#ff00ff"));
+    let coloured = canvas_pixels(client).await;
+    assert!(
+        differing_pixels(&dragged.2, &coloured.2) > 1000,
+        "the colour changed the picture"
+    );
+
+    // Toggle a crease on edge 7-12: click its middle, press C.
+    let middle = js(client, "const g = window.gradmesh; const p = g.state.layers[0].points; \
+        const [x, y] = g.toScreen((p[7][0] + p[12][0]) / 2, (p[7][1] + p[12][1]) / 2); \
+        const r = document.getElementById('overlay').getBoundingClientRect(); return [r.left + x, r.top + y];").await;
+    click(
+        client,
+        (middle[0].as_f64().unwrap(), middle[1].as_f64().unwrap()),
+    )
+    .await;
+    let edge = js(client, "return window.gradmesh.edge;").await;
+    assert_eq!(edge, json!([7, 12]), "clicking the edge selects it");
+    client
+        .find(Locator::Id("overlay"))
+        .await
+        .map_err(|e| e.to_string())?
+        .send_keys("c")
+        .await
+        .map_err(|e| e.to_string())?;
+    settle(client).await;
+    let kind = js(
+        client,
+        "return window.gradmesh.state.layers[0].edges.find(e => e[0] === 7 && e[1] === 12)[2];",
+    )
+    .await;
+    assert_eq!(kind, json!("crease"));
+    let creased = canvas_pixels(client).await;
+    assert!(
+        differing_pixels(&coloured.2, &creased.2) > 100,
+        "the crease changed the picture"
+    );
+
+    // A multi-resolution colour edit at level 2: select face 5 (click inside it), show its
+    // refined vertices, click the one at [1, 1] of the sector at point 7.
+    let centre = js(client, "const g = window.gradmesh; const l = g.state.layers[0]; \
+        const c = l.faces[5].map(p => l.points[p]).reduce((a, p) => [a[0] + p[0] / 4, a[1] + p[1] / 4], [0, 0]); \
+        const [x, y] = g.toScreen(...c); \
+        const r = document.getElementById('overlay').getBoundingClientRect(); return [r.left + x, r.top + y];").await;
+    click(
+        client,
+        (centre[0].as_f64().unwrap(), centre[1].as_f64().unwrap()),
+    )
+    .await;
+    assert_eq!(js(client, "return window.gradmesh.face;").await, json!(5));
+    type_into(client, "mr-level", "2").await?;
+    click_id(client, "mr-show").await?;
+    let deadline = Instant::now() + Duration::from_secs(20);
+    while js(client, "return !!window.gradmesh.refined;").await != json!(true) {
+        assert!(
+            Instant::now() < deadline,
+            "the refined vertices did not come"
+        );
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    let count = js(client, "return window.gradmesh.refined.vertices.length;").await;
+    assert_eq!(count, json!(64), "four sectors of 4 x 4 names at level 2");
+    let dot = js(client, "const g = window.gradmesh; \
+        const v = g.refined.vertices.find(v => v.point === 7 && v.at[0] === 1 && v.at[1] === 1); \
+        const [x, y] = g.toScreen(...v.position); \
+        const r = document.getElementById('overlay').getBoundingClientRect(); return [r.left + x, r.top + y];").await;
+    click(client, (dot[0].as_f64().unwrap(), dot[1].as_f64().unwrap())).await;
+    let fields = js(
+        client,
+        "return ['mr-level', 'mr-face', 'mr-point', 'mr-i', 'mr-j'] \
+        .map(id => document.getElementById(id).value);",
+    )
+    .await;
+    assert_eq!(
+        fields,
+        json!(["2", "5", "7", "1", "1"]),
+        "clicking the refined vertex fills in its address"
+    );
+    js(
+        client,
+        "document.getElementById('mr-colour').value = '#00ffff'; return 0;",
+    )
+    .await;
+    client
+        .find(Locator::Id("mr-set"))
+        .await
+        .map_err(|e| e.to_string())?
+        .click()
+        .await
+        .map_err(|e| e.to_string())?;
+    settle(client).await;
+    let edits = js(client, "return window.gradmesh.state.layers[0].edits;").await;
+    assert_eq!(
+        edits,
+        json!([[2, 5, 7, [1, 1]]]),
+        "{}",
+        js(client, "return window.gradmesh.error;").await
+    );
+    let refined = canvas_pixels(client).await;
+    assert!(
+        differing_pixels(&creased.2, &refined.2) > 20,
+        "the refined edit changed the picture"
+    );
+    screenshot(client, "editor-edited.png").await;
+
+    // Save (Ctrl+S), and compare the canvas with gradmesh's render of the saved file.
+    client
+        .find(Locator::Id("overlay"))
+        .await
+        .map_err(|e| e.to_string())?
+        .send_keys("\u{E009}s\u{E009}")
+        .await
+        .map_err(|e| e.to_string())?;
+    settle(client).await;
+    let saved = gradmesh::formats::read_path(file).map_err(|e| e.to_string())?;
+    let layer = &saved.layers[0];
+    assert_eq!(layer.edits.len(), 1, "the saved file has the refined edit");
+    assert_eq!(layer.edge_tag(7, 12).kind, gradmesh::EdgeKind::Crease);
+    assert_eq!(layer.points[7].colour_text.as_deref(), Some("#ff00ff"));
+    let worst = compare_with_render(client, file, &refined).await;
+    assert!(
+        worst <= 2,
+        "the canvas differs from the render of the saved file by {worst} levels"
+    );
+
+    // The page's own requests need the token, and a page of another origin cannot open the
+    // WebSocket even with it.
+    let status = js(client, "return fetch('/api/state').then(r => r.status);").await;
+    assert_eq!(status, json!(401));
+    let socket_url = format!("ws://{}/ws?token={}", running.address, running.token);
+    client
+        .goto("data:text/html,<p>another site</p>")
+        .await
+        .map_err(|e| e.to_string())?;
+    let opened = client
+        .execute_async(
+            "const done = arguments[arguments.length - 1]; const s = new WebSocket(arguments[0]); \
+             s.onopen = () => done('opened'); s.onerror = () => done('refused');",
+            vec![json!(socket_url)],
+        )
+        .await
+        .map_err(|e| e.to_string())?;
+    assert_eq!(opened, json!("refused"));
+    Ok(())
+}
+
+/// The paper authors' Tucan (six layers, bottom first) as one document in `dir`.
+fn write_tucan(dir: &Path) -> PathBuf {
+    let source = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/realdata/gradientmeshimproved-off");
+    let layers = (0..6)
+        .rev()
+        .map(|i| {
+            let path = source.join(format!("Tucan_Tucan_Layer{i}.off"));
+            let mut doc = gradmesh::formats::read_path(&path)
+                .unwrap_or_else(|e| panic!("the Tucan artwork ({}): {e}", path.display()));
+            doc.layers.remove(0)
+        })
+        .collect();
+    let file = dir.join("tucan.json");
+    let text = gradmesh::formats::json::write_document(&gradmesh::Document { layers });
+    std::fs::write(&file, text).unwrap();
+    file
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_tucan_in_a_real_browser() {
+    let driver = start_driver();
+    let dir = tempfile::tempdir().unwrap();
+    let file = write_tucan(dir.path());
+    let running = start(&Config {
+        file: Some(file),
+        folder: None,
+        port: 0,
+    })
+    .await
+    .unwrap();
+    let client = open_browser(&driver).await;
+    let result = show_tucan(&client, &running).await;
+    client.close().await.ok();
+    result.expect("the browser session");
+}
+
+/// Opens the Tucan, selects the beak's layer and a box of its points, and compares the canvas
+/// with gradmesh's render of the file.
+async fn show_tucan(client: &Client, running: &Running) -> Result<(), String> {
+    client
+        .goto(&running.url())
+        .await
+        .map_err(|e| e.to_string())?;
+    settle(client).await;
+    let layers = js(
+        client,
+        "return document.querySelectorAll('#layers li').length;",
+    )
+    .await;
+    assert_eq!(layers, json!(6), "the layer list shows the six layers");
+    let canvas = canvas_pixels(client).await;
+    let file = dir_file(running);
+    let worst = compare_with_render(client, &file, &canvas).await;
+    assert!(
+        worst <= 2,
+        "the canvas differs from the render of the file by {worst} levels"
+    );
+    // The beak's layer (third in the list, which shows the top layer first) becomes the
+    // active one; a box selects some of its points.
+    let items = client
+        .find_all(Locator::Css("#layers li"))
+        .await
+        .map_err(|e| e.to_string())?;
+    items[2].click().await.map_err(|e| e.to_string())?;
+    let active = js(client, "return window.gradmesh.activeLayer;").await;
+    assert_eq!(active, json!(3));
+    let bounds = js(
+        client,
+        "const r = document.getElementById('overlay').getBoundingClientRect(); \
+        return [r.left, r.top, r.width, r.height];",
+    )
+    .await;
+    let b: Vec<f64> = (0..4).map(|i| bounds[i].as_f64().unwrap()).collect();
+    drag(
+        client,
+        (b[0] + 0.55 * b[2], b[1] + 0.2 * b[3]),
+        (0.25 * b[2], 0.3 * b[3]),
+    )
+    .await;
+    let selected = js(client, "return window.gradmesh.selection.length;").await;
+    assert!(selected.as_u64().unwrap() > 0, "the box selects points");
+    screenshot(client, "editor-tucan.png").await;
+    Ok(())
+}
+
+/// The file the server saves to (the one it opened, here).
+fn dir_file(running: &Running) -> PathBuf {
+    let editor = running.app.editor();
+    editor.path.clone().expect("the document's file")
+}
