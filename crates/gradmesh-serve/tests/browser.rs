@@ -75,7 +75,26 @@ fn start_driver() -> Driver {
     Driver { child, url }
 }
 
-async fn open_browser(driver: &Driver) -> Client {
+/// A Chromium session through a chromedriver of its own. Chromium's first start on a fresh
+/// machine can reset the driver's connection; a session that fails to start is retried with a
+/// new driver, three times at most.
+async fn open_browser() -> (Driver, Client) {
+    let mut attempt = 1;
+    loop {
+        let driver = start_driver();
+        match try_open_browser(&driver).await {
+            Ok(client) => return (driver, client),
+            Err(e) if attempt < 3 => {
+                eprintln!("a Chromium session did not start ({e}); retrying");
+                attempt += 1;
+                tokio::time::sleep(Duration::from_secs(1)).await;
+            }
+            Err(e) => panic!("a Chromium session through chromedriver: {e}"),
+        }
+    }
+}
+
+async fn try_open_browser(driver: &Driver) -> Result<Client, fantoccini::error::NewSessionError> {
     let chromium = program(&["chromium", "chromium-browser"]);
     let mut caps = serde_json::Map::new();
     caps.insert(
@@ -93,8 +112,11 @@ async fn open_browser(driver: &Driver) -> Client {
         .capabilities(caps)
         .connect(&driver.url)
         .await
-        .expect("a Chromium session through chromedriver")
 }
+
+/// One browser at a time: two Chromium starts at once on two cores are what makes a start
+/// fail.
+static ONE_BROWSER: tokio::sync::Mutex<()> = tokio::sync::Mutex::const_new(());
 
 async fn js(client: &Client, script: &str) -> Value {
     client
@@ -293,7 +315,7 @@ fn copy_example(dir: &Path) -> PathBuf {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn edit_in_a_real_browser() {
-    let driver = start_driver();
+    let _one = ONE_BROWSER.lock().await;
     let dir = tempfile::tempdir().unwrap();
     let file = copy_example(dir.path());
     let running = start(&Config {
@@ -303,7 +325,7 @@ async fn edit_in_a_real_browser() {
     })
     .await
     .unwrap();
-    let client = open_browser(&driver).await;
+    let (_driver, client) = open_browser().await;
     let result = run_session(&client, &running, &file).await;
     client.close().await.ok();
     result.expect("the browser session");
@@ -551,7 +573,7 @@ fn write_tucan(dir: &Path) -> PathBuf {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_tucan_in_a_real_browser() {
-    let driver = start_driver();
+    let _one = ONE_BROWSER.lock().await;
     let dir = tempfile::tempdir().unwrap();
     let file = write_tucan(dir.path());
     let running = start(&Config {
@@ -561,7 +583,7 @@ async fn the_tucan_in_a_real_browser() {
     })
     .await
     .unwrap();
-    let client = open_browser(&driver).await;
+    let (_driver, client) = open_browser().await;
     let result = show_tucan(&client, &running).await;
     client.close().await.ok();
     result.expect("the browser session");
