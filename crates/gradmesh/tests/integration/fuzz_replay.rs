@@ -10,7 +10,14 @@ use std::fs;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
-const TARGETS: [&str; 5] = ["parse_json", "parse_off", "parse_obj", "pipeline", "render"];
+const TARGETS: [&str; 6] = [
+    "parse_json",
+    "parse_off",
+    "parse_obj",
+    "parse_svg",
+    "pipeline",
+    "render",
+];
 
 fn inputs(dir: &Path) -> Vec<PathBuf> {
     let Ok(entries) = fs::read_dir(dir) else {

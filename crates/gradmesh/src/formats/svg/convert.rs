@@ -6,7 +6,7 @@ use std::collections::BTreeSet;
 use kurbo::CubicBez;
 
 use super::scene::{MeshFill, MeshGrid, SvgScene};
-use crate::colour::ColourSpace;
+use crate::colour::{parse_css_colour, ColourSpace};
 use crate::error::Warning;
 use crate::mesh::{edge_key, ControlPoint, Document, GradientMesh};
 
@@ -55,12 +55,10 @@ pub fn fill_to_layer(fill: &MeshFill, space: ColourSpace) -> (GradientMesh, Vec<
         let root = merged.find(k);
         let corner = &grid.corners[k];
         if point_of[root] == u32::MAX {
-            let mut point = ControlPoint::new(
-                corner.position,
-                ColourSpace::Srgb.convert(space, corner.colour),
-            );
+            let (colour, colour_text) = layer_colour(corner.colour, space);
+            let mut point = ControlPoint::new(corner.position, colour);
             point.opacity = corner.opacity * opacity_scale;
-            point.colour_text = hex_colour(corner.colour);
+            point.colour_text = colour_text;
             mesh.points.push(point);
             point_of[root] = (mesh.points.len() - 1) as u32;
         } else if grid.corners[root].colour != corner.colour
@@ -217,6 +215,18 @@ fn set_handle_if_not_default(mesh: &mut GradientMesh, from: u32, to: u32, handle
 }
 
 /// `#rrggbb` when the colour is exactly an 8-bit sRGB colour, as stop colours are.
+/// A stop colour in the layer's space, with its `#rrggbb` text when it has one. A colour with
+/// text is converted as the native format reads that text, so that the document keeps the text
+/// through a write and read back.
+fn layer_colour(rgb: [f64; 3], space: ColourSpace) -> ([f64; 3], Option<String>) {
+    if let Some(text) = hex_colour(rgb) {
+        if let Ok((colour, _)) = parse_css_colour(&text, space) {
+            return (colour, Some(text));
+        }
+    }
+    (ColourSpace::Srgb.convert(space, rgb), None)
+}
+
 fn hex_colour(rgb: [f64; 3]) -> Option<String> {
     let bytes = rgb.map(|v| (v * 255.0).round());
     let exact = rgb

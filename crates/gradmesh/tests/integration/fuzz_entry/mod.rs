@@ -36,6 +36,7 @@ pub fn format_of_target(name: &str) -> Option<Format> {
         "parse_json" => Some(Format::Json),
         "parse_off" => Some(Format::Off),
         "parse_obj" => Some(Format::Obj),
+        "parse_svg" => Some(Format::Svg),
         _ => None,
     }
 }
@@ -420,9 +421,82 @@ pub fn pipeline_bytes(data: &[u8]) {
 /// Runs the entry point of fuzz target `target` on `data`.
 pub fn run_target(target: &str, data: &[u8]) {
     match format_of_target(target) {
+        Some(Format::Svg) => parse_svg(data),
         Some(format) => parse(format, data),
         None if target == "pipeline" => pipeline_bytes(data),
         None if target == "render" => render::render_bytes(data),
         None => panic!("unknown fuzz target {target}"),
+    }
+}
+
+/// Reads `data` as SVG: the normalised scene keeps the guarantees the reader documents (see
+/// [`check_scene`]), and the document converted from it goes through [`parse`]'s checks.
+pub fn parse_svg(data: &[u8]) {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return;
+    };
+    match formats::svg::read_svg_with_limits(text, &fuzz_limits()) {
+        Ok(scene) => check_scene(&scene),
+        Err(e) => check_error(&e),
+    }
+    parse(Format::Svg, data);
+}
+
+/// The reader's guarantees: every number finite; every mesh a full grid of at least one patch
+/// whose sides start and end at their corners; colours and opacities in 0..1; a view box, when
+/// there is one, with a positive size.
+pub fn check_scene(scene: &formats::svg::SvgScene) {
+    let finite = |p: kurbo::Point| p.x.is_finite() && p.y.is_finite();
+    let unit = |x: f64| (0.0..=1.0).contains(&x);
+    if let Some(view) = scene.view_rect() {
+        assert!(
+            view.width() > 0.0 && view.height() > 0.0 && finite(view.origin()),
+            "view box {view:?}"
+        );
+    }
+    for fill in &scene.fills {
+        let grid = &fill.mesh;
+        let (rows, columns) = (grid.rows, grid.columns);
+        assert!(
+            rows >= 1 && columns >= 1,
+            "an empty grid in {}",
+            fill.gradient_id
+        );
+        assert_eq!(grid.corners.len(), (rows + 1) * (columns + 1));
+        assert_eq!(grid.row_sides.len(), (rows + 1) * columns);
+        assert_eq!(grid.column_sides.len(), rows * (columns + 1));
+        assert!(unit(fill.fill_opacity) && unit(fill.group_opacity));
+        for corner in &grid.corners {
+            assert!(finite(corner.position), "corner {corner:?}");
+            assert!(corner.colour.iter().all(|&c| unit(c)) && unit(corner.opacity));
+        }
+        for i in 0..=rows {
+            for j in 0..=columns {
+                let at = grid.corner(i, j).position;
+                if j < columns {
+                    let side = grid.row_side(i, j);
+                    assert_eq!((side.p0, side.p3), (at, grid.corner(i, j + 1).position));
+                }
+                if i < rows {
+                    let side = grid.column_side(i, j);
+                    assert_eq!((side.p0, side.p3), (at, grid.corner(i + 1, j).position));
+                }
+            }
+        }
+        let sides = grid.row_sides.iter().chain(&grid.column_sides);
+        assert!(sides.flat_map(|s| [s.p1, s.p2]).all(finite));
+        for element in fill.clip.elements() {
+            let points: Vec<kurbo::Point> = match *element {
+                kurbo::PathEl::MoveTo(a) | kurbo::PathEl::LineTo(a) => vec![a],
+                kurbo::PathEl::QuadTo(a, b) => vec![a, b],
+                kurbo::PathEl::CurveTo(a, b, c) => vec![a, b, c],
+                kurbo::PathEl::ClosePath => vec![],
+            };
+            assert!(
+                points.into_iter().all(finite),
+                "the clip of {}",
+                fill.gradient_id
+            );
+        }
     }
 }
