@@ -311,11 +311,12 @@ pub struct RenderArgs {
     /// spots and the surface.
     #[arg(long, value_name = "PT", default_value_t = gradmesh::export::DEFAULT_GEOMETRY_TOLERANCE_PX, help_heading = "Vector output")]
     pub geometry_tolerance: f64,
-    /// PDF: the shadings' colour space (Lab, or sRGB for viewers that interpolate in RGB).
+    /// PDF: the shadings' colour space (sRGB, drawn alike by every viewer; or Lab, for viewers
+    /// that interpolate in Lab and convert it exactly).
     #[arg(
         long,
         value_name = "SPACE",
-        default_value = "lab",
+        default_value = "srgb",
         help_heading = "Vector output"
     )]
     pub pdf_colour: PdfColourArg,

@@ -42,7 +42,7 @@ fn a_pdf_is_written_with_the_png_page_size() {
     let text = String::from_utf8_lossy(&bytes);
     assert!(bytes.starts_with(b"%PDF-"));
     assert!(
-        text.contains("/ShadingType 7") && text.contains("/Lab"),
+        text.contains("/ShadingType 7") && text.contains("/DeviceRGB"),
         "{text:.400}"
     );
     let o = gradmesh(&["render", s(&input), "-o", s(&png), "--width", "160"]);
@@ -75,11 +75,39 @@ fn pdf_colour_and_tolerance_flags() {
         let bytes = std::fs::read(&out).unwrap();
         (String::from_utf8_lossy(&bytes).into_owned(), bytes.len())
     };
-    let (srgb, _) = size(&["--pdf-colour", "srgb"]);
-    assert!(srgb.contains("/DeviceRGB") && !srgb.contains("/Lab"));
+    let (default, _) = size(&[]);
+    assert!(default.contains("/DeviceRGB") && !default.contains("/Lab"));
+    let (lab, _) = size(&["--pdf-colour", "lab"]);
+    assert!(lab.contains("/Lab"));
     let (_, coarse) = size(&["--tolerance", "2"]);
     let (_, fine) = size(&["--tolerance", "0.2"]);
     assert!(fine > 2 * coarse, "{fine} vs {coarse}");
+}
+
+#[test]
+fn png_only_flags_are_named_in_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = example("irregular-vertex.json");
+    let out = dir.path().join("flags.svg");
+    let o = gradmesh(&[
+        "render",
+        s(&input),
+        "-o",
+        s(&out),
+        "--width",
+        "64",
+        "--bits",
+        "16",
+        "--boundary",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--bits, --boundary only apply to PNG output"),
+        "{}",
+        stderr(&o)
+    );
+    let o = gradmesh(&["render", s(&input), "-o", s(&out), "--width", "64"]);
+    assert!(!stderr(&o).contains("warning"), "{}", stderr(&o));
 }
 
 #[test]

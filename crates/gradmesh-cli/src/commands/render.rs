@@ -211,6 +211,7 @@ fn vector(
     origins: &[(&std::path::Path, usize)],
     read: std::time::Duration,
 ) -> Result<(), Error> {
+    warn_of_png_flags(args);
     let mut opts = ExportOptions::new(render.width, render.height, render.view);
     opts.tolerance = args.tolerance;
     opts.geometry_tolerance_px = args.geometry_tolerance;
@@ -246,6 +247,36 @@ fn vector(
         );
     }
     Ok(())
+}
+
+/// Warns of the flags given that only PNG output uses.
+fn warn_of_png_flags(args: &RenderArgs) {
+    let given = [
+        (args.background.is_some(), "--background"),
+        (args.bits != 8, "--bits"),
+        (args.no_dither, "--no-dither"),
+        (args.linear_colour, "--linear-colour"),
+        (args.boundary, "--boundary"),
+        (args.colour_space.is_some(), "--colour-space"),
+        (
+            !matches!(args.gamut, crate::args::GamutArg::Chroma),
+            "--gamut",
+        ),
+        (args.reference, "--reference"),
+        (args.level.is_some(), "--level"),
+    ];
+    let ignored: Vec<&str> = given
+        .iter()
+        .filter(|(given, _)| *given)
+        .map(|(_, flag)| *flag)
+        .collect();
+    if !ignored.is_empty() {
+        eprintln!(
+            "gradmesh: warning: {}: {} only apply to PNG output: ignored",
+            args.output.display(),
+            ignored.join(", ")
+        );
+    }
 }
 
 /// Prints warning `w`, naming the file and layer its layer came from (`origins`).

@@ -58,14 +58,19 @@ pub const DEFAULT_TOLERANCE: f64 = 0.5;
 pub const DEFAULT_GEOMETRY_TOLERANCE_PX: f64 = 0.1;
 
 /// The colour space a PDF's shadings are written in.
+///
+/// sRGB is the default: every viewer tested draws it within the tolerance's reach, while `/Lab`
+/// depends on each viewer's Lab conversion (MuPDF without a colour management module is
+/// several ΔE00 off, and viewers that interpolate in RGB whatever the space darken Lab
+/// mid-tones); see `docs/export.md`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum PdfColour {
-    /// CIE L*a*b* with the D65 white point (`/Lab`): what viewers that interpolate in the
-    /// shading's space (MuPDF, Ghostscript, poppler's `pdftoppm`) interpolate in.
-    #[default]
+    /// CIE L*a*b* with the D65 white point (`/Lab`), for viewers that interpolate in the
+    /// shading's space and convert Lab exactly (poppler's `pdftoppm` matches best in it).
     Lab,
     /// `/DeviceRGB` taken as sRGB, with patches split so that interpolating sRGB values also
-    /// stays within the tolerance: for viewers that interpolate in RGB whatever the space.
+    /// stays within the tolerance.
+    #[default]
     Srgb,
 }
 

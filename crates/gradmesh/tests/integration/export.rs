@@ -385,7 +385,8 @@ fn examples_match_the_render_in_every_pdf_renderer() {
     ] {
         let doc = example(name);
         let render = RenderOptions::fit(&doc, 256);
-        let opts = ExportOptions::new(render.width, render.height, render.view);
+        let mut opts = ExportOptions::new(render.width, render.height, render.view);
+        opts.colour = PdfColour::Lab;
         let (results, _) = check_document(&doc, &opts, name.trim_end_matches(".json"));
         assert_close(name, &results, lab_bar);
         let mut opts = opts.clone();
