@@ -5,7 +5,8 @@
 //! refuses it whole if any layer is invalid.
 
 use gradmesh::{
-    parse_css_colour, ColourSpace, Document, EdgeKind, Edit, GradientMesh, SHARPNESS_INFINITE,
+    parse_css_colour, ColourSpace, Document, EdgeKind, Edit, GradientMesh, VertexAddress,
+    SHARPNESS_INFINITE,
 };
 use kurbo::{CubicBez, ParamCurve, Point, Vec2};
 use serde::Deserialize;
@@ -209,7 +210,9 @@ pub enum Op {
         #[serde(default)]
         css: Option<String>,
     },
-    /// Sets or removes the multi-resolution colour and opacity edit of a refined vertex.
+    /// Sets or removes the multi-resolution edit of a refined vertex: its colour and opacity
+    /// are replaced, its position offset is replaced if given and kept if not. Neither colour,
+    /// opacity nor offset: the edit is removed.
     SetRefinedEdit {
         /// The layer.
         layer: usize,
@@ -227,6 +230,27 @@ pub enum Op {
         /// New opacity (absent: no opacity edit).
         #[serde(default)]
         opacity: Option<f64>,
+        /// New position offset `[u, v]` in the vertex's frame (absent: the edit's offset stays).
+        #[serde(default)]
+        offset: Option<[f64; 2]>,
+    },
+    /// Moves a refined vertex: sets its edit's position offset so that its limit position moves
+    /// by `(dx, dy)` from where it is. Refused on a layer that allows colour edits only.
+    MoveRefinedVertex {
+        /// The layer.
+        layer: usize,
+        /// Level of the refined vertex (1 or more).
+        level: u32,
+        /// The control face it lies in.
+        face: u32,
+        /// The corner of that face whose sector holds it.
+        point: u32,
+        /// Its place in the sector's grid.
+        at: [u32; 2],
+        /// The move in x.
+        dx: f64,
+        /// The move in y.
+        dy: f64,
     },
 }
 
@@ -294,7 +318,8 @@ impl Op {
             | Op::RenameLayer { layer, .. }
             | Op::DeleteLayer { layer }
             | Op::SetSideColour { layer, .. }
-            | Op::SetRefinedEdit { layer, .. } => *layer,
+            | Op::SetRefinedEdit { layer, .. }
+            | Op::MoveRefinedVertex { layer, .. } => *layer,
             Op::AddLayer { .. } => 0,
         }
     }
@@ -362,15 +387,24 @@ impl Op {
                 at,
                 colour,
                 opacity,
+                offset,
                 ..
             } => {
-                let address = gradmesh::VertexAddress {
-                    level: *level,
-                    face: *face,
-                    point: *point,
-                    at: *at,
-                };
-                set_refined_edit(mesh, address, *colour, *opacity)
+                let address = VertexAddress::new(*level, *face, *point, *at);
+                let offset = offset.map(|[u, v]| Vec2::new(u, v));
+                set_refined_edit(mesh, address, *colour, *opacity, offset)
+            }
+            Op::MoveRefinedVertex {
+                level,
+                face,
+                point,
+                at,
+                dx,
+                dy,
+                ..
+            } => {
+                let address = VertexAddress::new(*level, *face, *point, *at);
+                move_refined_vertex(mesh, address, Vec2::new(*dx, *dy))
             }
             Op::AddLayer { .. }
             | Op::MoveLayer { .. }
@@ -701,22 +735,36 @@ fn remove_faces_and_points(
 
 fn set_refined_edit(
     mesh: &mut GradientMesh,
-    address: gradmesh::VertexAddress,
+    address: VertexAddress,
     colour: Option<[f64; 3]>,
     opacity: Option<f64>,
+    offset: Option<Vec2>,
 ) -> Result<(), String> {
-    if colour.is_none() && opacity.is_none() {
+    if colour.is_none() && opacity.is_none() && offset.is_none() {
         mesh.remove_edit(&address);
         return Ok(());
     }
-    let mut edit = mesh.edit(&address).cloned().unwrap_or(Edit {
-        address,
-        colour: None,
-        opacity: None,
-        offset: None,
-    });
+    let mut edit = (mesh.edit(&address).cloned()).unwrap_or_else(|| Edit::new(address));
     edit.colour = colour.map(gradmesh::ColourEdit::Set);
     edit.opacity = opacity.map(gradmesh::OpacityEdit::Set);
+    if offset.is_some() {
+        edit.offset = offset;
+    }
+    mesh.set_edit(edit);
+    Ok(())
+}
+
+fn move_refined_vertex(
+    mesh: &mut GradientMesh,
+    address: VertexAddress,
+    shift: Vec2,
+) -> Result<(), String> {
+    if !(shift.x.is_finite() && shift.y.is_finite()) {
+        return Err("a move must be finite numbers".into());
+    }
+    let offset = crate::refined::offset_for_move(mesh, address, shift)?;
+    let mut edit = (mesh.edit(&address).cloned()).unwrap_or_else(|| Edit::new(address));
+    edit.offset = Some(offset);
     mesh.set_edit(edit);
     Ok(())
 }

@@ -135,7 +135,8 @@ fn layer_json(mesh: &GradientMesh, hidden: bool, folds: Option<&[[f64; 3]]>) -> 
                 e.address.level,
                 e.address.face,
                 e.address.point,
-                e.address.at
+                e.address.at,
+                e.offset.map(|o| [o.x, o.y]),
             ])
         })
         .collect();

@@ -1,5 +1,6 @@
 //! The server's API without a browser: the token, `Host` and `Origin` checks, the folder's
-//! bounds, body limits, malformed requests, saving, and a page that goes away mid-edit.
+//! bounds, body limits, malformed requests, saving, a page that goes away mid-edit, and the
+//! multi-resolution and side edits.
 
 use std::path::Path;
 
@@ -389,4 +390,125 @@ async fn an_oversized_websocket_message_closes_only_that_connection() {
     );
     let (status, _) = get(&running, &format!("/api/state?token={}", running.token)).await;
     assert_eq!(status, 200, "the server goes on");
+}
+
+// ---- multi-resolution and side edits through the API ----------------------------------------
+
+async fn edit_command(
+    running: &Running,
+    op: serde_json::Value,
+    gesture: Option<u64>,
+) -> (u16, String) {
+    let mut command_json = serde_json::json!({"type": "edit", "op": op});
+    if let Some(g) = gesture {
+        command_json["gesture"] = g.into();
+    }
+    command(running, &command_json.to_string()).await
+}
+
+async fn document(running: &Running) -> gradmesh::Document {
+    let (status, text) = get(
+        running,
+        &format!("/api/document.json?token={}", running.token),
+    )
+    .await;
+    assert_eq!(status, 200, "{text}");
+    gradmesh::formats::json::read_document(&text).unwrap()
+}
+
+/// The limit position of the refined vertex `at` of the sector of `point` in face 0, level 2.
+async fn refined_position(running: &Running, point: u32, at: [u32; 2]) -> [f64; 2] {
+    let target = format!(
+        "/api/refined?token={}&layer=0&face=0&level=2",
+        running.token
+    );
+    let (status, text) = get(running, &target).await;
+    assert_eq!(status, 200, "{text}");
+    let vertices: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let v = (vertices.as_array().unwrap().iter())
+        .find(|v| v["point"] == point && v["at"] == serde_json::json!(at))
+        .expect("the vertex is listed");
+    [
+        v["position"][0].as_f64().unwrap(),
+        v["position"][1].as_f64().unwrap(),
+    ]
+}
+
+fn assert_near(got: [f64; 2], want: [f64; 2]) {
+    let d = (got[0] - want[0]).hypot(got[1] - want[1]);
+    assert!(d < 1e-6, "at {got:?}, expected {want:?}");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_refined_vertex_moves_where_it_is_dragged_and_undoes() {
+    let (running, _dir) = serve_square().await;
+    let centre = [50.0, 50.0];
+    let mv = |dx: f64, dy: f64| {
+        serde_json::json!({"op": "move_refined_vertex", "layer": 0, "level": 2, "face": 0,
+            "point": 0, "at": [1, 2], "dx": dx, "dy": dy})
+    };
+    let start = refined_position(&running, 0, [1, 2]).await;
+    assert_near(refined_position(&running, 0, [3, 3]).await, centre);
+    // Two moves of one gesture: each from where the gesture began, so the second wins.
+    assert_eq!(edit_command(&running, mv(30.0, 5.0), Some(1)).await.0, 200);
+    assert_eq!(edit_command(&running, mv(12.0, -7.0), Some(1)).await.0, 200);
+    assert_eq!(command(&running, r#"{"type":"end_gesture"}"#).await.0, 200);
+    let moved = [start[0] + 12.0, start[1] - 7.0];
+    assert_near(refined_position(&running, 0, [1, 2]).await, moved);
+    let edit = document(&running).await.layers[0].edits[0].clone();
+    assert!(edit.offset.is_some() && edit.colour.is_none());
+    // A second drag starts from where the first left it.
+    assert_eq!(edit_command(&running, mv(-2.0, 4.0), Some(2)).await.0, 200);
+    assert_near(
+        refined_position(&running, 0, [1, 2]).await,
+        [moved[0] - 2.0, moved[1] + 4.0],
+    );
+    assert_eq!(command(&running, r#"{"type":"undo"}"#).await.0, 200);
+    assert_near(refined_position(&running, 0, [1, 2]).await, moved);
+    assert_eq!(command(&running, r#"{"type":"undo"}"#).await.0, 200);
+    assert_near(refined_position(&running, 0, [1, 2]).await, start);
+    assert!(document(&running).await.layers[0].edits.is_empty());
+    assert_eq!(command(&running, r#"{"type":"redo"}"#).await.0, 200);
+    assert_near(refined_position(&running, 0, [1, 2]).await, moved);
+    // Setting a colour keeps the move; an offset can be given outright, in the vertex's frame.
+    let set = serde_json::json!({"op": "set_refined_edit", "layer": 0, "level": 2, "face": 0,
+        "point": 0, "at": [1, 2], "colour": [50.0, 20.0, 0.0]});
+    assert_eq!(edit_command(&running, set, None).await.0, 200);
+    assert_near(refined_position(&running, 0, [1, 2]).await, moved);
+    let set = serde_json::json!({"op": "set_refined_edit", "layer": 0, "level": 2, "face": 0,
+        "point": 0, "at": [1, 2], "colour": [50.0, 20.0, 0.0], "offset": [0.0, 0.0]});
+    assert_eq!(edit_command(&running, set, None).await.0, 200);
+    assert_near(refined_position(&running, 0, [1, 2]).await, start);
+    // The centre was not moved by any of it.
+    assert_near(refined_position(&running, 0, [3, 3]).await, centre);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_colour_only_layer_refuses_moving_a_refined_vertex_with_the_validators_message() {
+    let (running, dir) = serve_square().await;
+    let colour_only = SQUARE.replace(
+        r#""name":"square","#,
+        r#""name":"square","fine_edits":"colour-only","#,
+    );
+    std::fs::write(dir.path().join("colour-only.json"), colour_only).unwrap();
+    let open = r#"{"type":"open","name":"colour-only.json"}"#;
+    assert_eq!(command(&running, open).await.0, 200);
+    let mv = serde_json::json!({"op": "move_refined_vertex", "layer": 0, "level": 2, "face": 0,
+        "point": 0, "at": [1, 2], "dx": 3.0, "dy": 0.0});
+    let (status, text) = edit_command(&running, mv, None).await;
+    assert_eq!(status, 422, "{text}");
+    assert!(text.contains("colour edits only"), "{text}");
+    let set = serde_json::json!({"op": "set_refined_edit", "layer": 0, "level": 2, "face": 0,
+        "point": 0, "at": [1, 2], "offset": [0.5, 0.0]});
+    let (status, text) = edit_command(&running, set, None).await;
+    assert_eq!(status, 422, "{text}");
+    assert!(text.contains("colour edits only"), "{text}");
+    assert!(document(&running).await.layers[0].edits.is_empty());
+    let state = get(&running, &format!("/api/state?token={}", running.token))
+        .await
+        .1;
+    assert!(
+        state.contains(r#""can_undo":false"#),
+        "a refused edit makes no step"
+    );
 }
