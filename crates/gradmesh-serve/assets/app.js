@@ -729,6 +729,7 @@ $("layer-delete").onclick = () => {
 };
 $("side-colour").onclick = () => sideColour($("colour-picker").value);
 $("side-clear").onclick = () => sideColour(null);
+$("side-opacity-set").onclick = sideOpacity;
 $("mr-show").onclick = () => {
   if (editor.face === null) { showMessage("Select a face first (click inside it)."); return; }
   loadRefined(editor.activeLayer, editor.face, Number($("mr-level").value));
@@ -737,14 +738,31 @@ $("mr-hide").onclick = () => { refinedRequests++; editor.refined = null; drawOve
 $("mr-set").onclick = () => refinedEdit(true);
 $("mr-clear").onclick = () => refinedEdit(false);
 
-// The colour of the selected point on the side of the selected face (at a discontinuity).
-function sideColour(css) {
+// The selected point and the selected face around it: a side of a discontinuity, or null.
+function selectedSide() {
   if (editor.selection.length !== 1 || editor.face === null) {
     showMessage("Select one point, then Shift+click inside a face around it.");
-    return;
+    return null;
   }
-  const op = { op: "set_side_colour", layer: editor.activeLayer, point: editor.selection[0], face: editor.face };
+  return { layer: editor.activeLayer, point: editor.selection[0], face: editor.face };
+}
+
+// The colour of the selected point on the side of the selected face (at a discontinuity).
+function sideColour(css) {
+  const side = selectedSide();
+  if (!side) return;
+  const op = { op: "set_side_colour", ...side };
   if (css) op.css = css;
+  edit(op);
+}
+
+// The opacity of that side; an empty field gives it the point's opacity again.
+function sideOpacity() {
+  const side = selectedSide();
+  if (!side) return;
+  const op = { op: "set_side_opacity", ...side };
+  const text = $("side-opacity").value.trim();
+  if (text !== "") op.opacity = Number(text);
   edit(op);
 }
 
@@ -861,6 +879,8 @@ function updatePointPanel(layer) {
   ["c0", "c1", "c2"].forEach((id, k) => { if (active !== $(id)) $(id).value = +layer.colours[p][k].toFixed(4); });
   if (active !== $("opacity")) $("opacity").value = layer.opacity[p];
   $("opacity-value").textContent = layer.opacity[p].toFixed(2);
+  const side = layer.sides.find(([q, f]) => q === p && f === editor.face);
+  if (active !== $("side-opacity")) $("side-opacity").value = side && side[3] !== null ? side[3] : "";
 }
 
 function updateWarnings(state) {

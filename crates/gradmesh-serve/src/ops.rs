@@ -210,6 +210,20 @@ pub enum Op {
         #[serde(default)]
         css: Option<String>,
     },
+    /// Sets the opacity of one side of a discontinuity: of `point` in the wedge of faces that
+    /// holds `face`. A side without its own entry gets one with the point's colour (the format
+    /// requires a side's colour). No `opacity`: the side takes the point's opacity again.
+    SetSideOpacity {
+        /// The layer.
+        layer: usize,
+        /// The point on the discontinuous edge.
+        point: u32,
+        /// A face around the point, on the side to change.
+        face: u32,
+        /// Opacity in 0..=1.
+        #[serde(default)]
+        opacity: Option<f64>,
+    },
     /// Sets or removes the multi-resolution edit of a refined vertex: its colour and opacity
     /// are replaced, its position offset is replaced if given and kept if not. Neither colour,
     /// opacity nor offset: the edit is removed.
@@ -318,6 +332,7 @@ impl Op {
             | Op::RenameLayer { layer, .. }
             | Op::DeleteLayer { layer }
             | Op::SetSideColour { layer, .. }
+            | Op::SetSideOpacity { layer, .. }
             | Op::SetRefinedEdit { layer, .. }
             | Op::MoveRefinedVertex { layer, .. } => *layer,
             Op::AddLayer { .. } => 0,
@@ -366,6 +381,12 @@ impl Op {
                 css,
                 ..
             } => set_side_colour(mesh, *point, *face, *colour, css.as_deref()),
+            Op::SetSideOpacity {
+                point,
+                face,
+                opacity,
+                ..
+            } => set_side_opacity(mesh, *point, *face, *opacity),
             Op::SplitFace { face, a, b, .. } => split_face(mesh, *face, *a, *b),
             Op::AddFace { points, .. } => {
                 for &p in points {
@@ -487,13 +508,9 @@ fn set_colour(
     Ok(())
 }
 
-fn set_side_colour(
-    mesh: &mut GradientMesh,
-    point: u32,
-    face: u32,
-    colour: Option<[f64; 3]>,
-    css: Option<&str>,
-) -> Result<(), String> {
+/// The index in `mesh.wedges` of the entry of the side of `point` named by `face`, if it has
+/// one; fails if the point or face does not exist or the face does not hold the point.
+fn side_entry(mesh: &mut GradientMesh, point: u32, face: u32) -> Result<Option<usize>, String> {
     point_mut(mesh, point)?;
     let corners = mesh
         .faces
@@ -502,7 +519,42 @@ fn set_side_colour(
     if !corners.contains(&point) {
         return Err(format!("point {point} is not a corner of face {face}"));
     }
-    let existing = (mesh.wedges.iter()).position(|w| w.point == point && w.face == face);
+    Ok((mesh.wedges.iter()).position(|w| w.point == point && w.face == face))
+}
+
+fn set_side_opacity(
+    mesh: &mut GradientMesh,
+    point: u32,
+    face: u32,
+    opacity: Option<f64>,
+) -> Result<(), String> {
+    let existing = side_entry(mesh, point, face)?;
+    match (existing, opacity) {
+        (Some(i), _) => mesh.wedges[i].opacity = opacity,
+        (None, None) => {}
+        (None, Some(_)) => {
+            let p = &mesh.points[point as usize];
+            mesh.wedges.push(gradmesh::WedgeOverride {
+                point,
+                face,
+                colour: p.colour,
+                colour_text: p.colour_text.clone(),
+                opacity,
+                handles: Default::default(),
+            });
+        }
+    }
+    Ok(())
+}
+
+fn set_side_colour(
+    mesh: &mut GradientMesh,
+    point: u32,
+    face: u32,
+    colour: Option<[f64; 3]>,
+    css: Option<&str>,
+) -> Result<(), String> {
+    let existing = side_entry(mesh, point, face)?;
     if colour.is_none() && css.is_none() {
         if let Some(i) = existing {
             mesh.wedges.remove(i);

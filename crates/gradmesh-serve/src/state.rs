@@ -143,7 +143,7 @@ fn layer_json(mesh: &GradientMesh, hidden: bool, folds: Option<&[[f64; 3]]>) -> 
     let sides: Vec<Value> = mesh
         .wedges
         .iter()
-        .map(|w| json!([w.point, w.face, srgb_hex(space, w.colour)]))
+        .map(|w| json!([w.point, w.face, srgb_hex(space, w.colour), w.opacity]))
         .collect();
     json!({
         "name": mesh.name,

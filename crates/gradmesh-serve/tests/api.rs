@@ -512,3 +512,85 @@ async fn a_colour_only_layer_refuses_moving_a_refined_vertex_with_the_validators
         "a refused edit makes no step"
     );
 }
+
+/// Two squares side by side, the edge between them (points 1 and 4) discontinuous.
+const TWO_SIDES: &str = r##"{"format":"gradmesh","version":1,"layers":[{"name":"two","points":[
+  {"position":[0,0],"colour":"#d04020"},{"position":[100,0],"colour":"#e0c030"},
+  {"position":[200,0],"colour":"#2060c0"},{"position":[0,100],"colour":"#40a040"},
+  {"position":[100,100],"colour":"#802080"},{"position":[200,100],"colour":"#208080"}],
+  "faces":[[0,1,4,3],[1,2,5,4]],
+  "edges":[{"points":[1,4],"kind":"discontinuous"}]}]}"##;
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_side_of_a_discontinuity_takes_its_own_opacity_and_undoes() {
+    let (running, dir) = serve_square().await;
+    std::fs::write(dir.path().join("two.json"), TWO_SIDES).unwrap();
+    assert_eq!(
+        command(&running, r#"{"type":"open","name":"two.json"}"#)
+            .await
+            .0,
+        200
+    );
+    let side_opacity = |opacity: Option<f64>| {
+        let mut op =
+            serde_json::json!({"op": "set_side_opacity", "layer": 0, "point": 1, "face": 1});
+        if let Some(o) = opacity {
+            op["opacity"] = o.into();
+        }
+        op
+    };
+    // A side without an entry gets one, with the point's colour.
+    let (status, state) = edit_command(&running, side_opacity(Some(0.25)), None).await;
+    assert_eq!(status, 200, "{state}");
+    assert!(
+        state.contains(r##""sides":[[1,1,"#e0c030",0.25]]"##),
+        "{state}"
+    );
+    let layer = document(&running).await.layers.remove(0);
+    assert_eq!(layer.wedges.len(), 1);
+    let side = &layer.wedges[0];
+    assert_eq!((side.point, side.face, side.opacity), (1, 1, Some(0.25)));
+    assert_eq!(side.colour, layer.points[1].colour);
+    assert_eq!(
+        layer.points[1].opacity, 1.0,
+        "the point itself keeps its opacity"
+    );
+    // A side's colour and opacity are kept apart: recolouring keeps the opacity, and no
+    // opacity keeps the colour.
+    let colour = serde_json::json!({"op": "set_side_colour", "layer": 0, "point": 1, "face": 1,
+        "css": "#00ff00"});
+    assert_eq!(edit_command(&running, colour, None).await.0, 200);
+    assert_eq!(
+        document(&running).await.layers[0].wedges[0].opacity,
+        Some(0.25)
+    );
+    assert_eq!(
+        edit_command(&running, side_opacity(None), None).await.0,
+        200
+    );
+    let side = document(&running).await.layers[0].wedges[0].clone();
+    assert_eq!(
+        (side.opacity, side.colour_text.as_deref()),
+        (None, Some("#00ff00"))
+    );
+    // Out of range: the validator's message, nothing changed.
+    let (status, text) = edit_command(&running, side_opacity(Some(1.5)), None).await;
+    assert_eq!(status, 422, "{text}");
+    assert!(text.contains("opacity"), "{text}");
+    // Undo walks back through each step.
+    for _ in 0..2 {
+        assert_eq!(command(&running, r#"{"type":"undo"}"#).await.0, 200);
+    }
+    assert_eq!(
+        document(&running).await.layers[0].wedges[0].opacity,
+        Some(0.25)
+    );
+    assert_eq!(command(&running, r#"{"type":"undo"}"#).await.0, 200);
+    assert!(document(&running).await.layers[0].wedges.is_empty());
+    // A face that does not hold the point names no side.
+    let wrong = serde_json::json!({"op": "set_side_opacity", "layer": 0, "point": 0, "face": 1,
+        "opacity": 0.5});
+    let (status, text) = edit_command(&running, wrong, None).await;
+    assert_eq!(status, 422, "{text}");
+    assert!(text.contains("not a corner of face 1"), "{text}");
+}
