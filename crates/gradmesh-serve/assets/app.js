@@ -85,7 +85,7 @@ function receiveText(message) {
   if (message.type === "done") {
     editor.busy = false;
     flush();
-  } else if (message.type === "error") {
+  } else if (message.type === "error" || message.type === "notice") {
     showMessage(message.message);
   } else if (message.type === "state") {
     const first = editor.state === null;

@@ -269,16 +269,18 @@ pub enum Op {
 }
 
 impl Op {
-    /// Applies the edit to `picture`. Fails with a message for the user when the edit names
-    /// nothing that exists or makes no sense; the validity of the result is checked apart.
-    pub fn apply(&self, picture: &mut Picture) -> Result<(), String> {
+    /// Applies the edit to `picture`; returns a note for the user when the edit did more than
+    /// asked (a deletion that dropped multi-resolution edits). Fails with a message for the
+    /// user when the edit names nothing that exists or makes no sense; the validity of the
+    /// result is checked apart.
+    pub fn apply(&self, picture: &mut Picture) -> Result<Option<String>, String> {
         match self {
             Op::AddLayer { name } => {
                 let mut mesh = GradientMesh::new(ColourSpace::Lab);
                 mesh.name = name.clone();
                 picture.doc.layers.push(mesh);
                 picture.hidden.push(false);
-                Ok(())
+                Ok(None)
             }
             Op::MoveLayer { layer, to } => {
                 check_layer(picture, *layer)?;
@@ -287,28 +289,42 @@ impl Op {
                 let hidden = picture.hidden.remove(*layer);
                 picture.doc.layers.insert(*to, mesh);
                 picture.hidden.insert(*to, hidden);
-                Ok(())
+                Ok(None)
             }
             Op::SetLayerHidden { layer, hidden } => {
                 check_layer(picture, *layer)?;
                 picture.hidden[*layer] = *hidden;
-                Ok(())
+                Ok(None)
             }
             Op::RenameLayer { layer, name } => {
                 check_layer(picture, *layer)?;
                 picture.doc.layers[*layer].name = (!name.is_empty()).then(|| name.clone());
-                Ok(())
+                Ok(None)
             }
             Op::DeleteLayer { layer } => {
                 check_layer(picture, *layer)?;
                 picture.doc.layers.remove(*layer);
                 picture.hidden.remove(*layer);
-                Ok(())
+                Ok(None)
+            }
+            Op::DeletePoints { layer, .. } | Op::DeleteFaces { layer, .. } => {
+                check_layer(picture, *layer)?;
+                let mesh = &mut picture.doc.layers[*layer];
+                let edits = mesh.edits.len();
+                self.apply_to_mesh(mesh)?;
+                let dropped = edits - mesh.edits.len();
+                Ok((dropped > 0).then(|| {
+                    format!(
+                        "{dropped} multi-resolution edit{} on the deleted faces went with them",
+                        if dropped == 1 { "" } else { "s" }
+                    )
+                }))
             }
             _ => {
                 let layer = self.layer();
                 check_layer(picture, layer)?;
-                self.apply_to_mesh(&mut picture.doc.layers[layer])
+                self.apply_to_mesh(&mut picture.doc.layers[layer])?;
+                Ok(None)
             }
         }
     }
@@ -712,17 +728,13 @@ fn delete_faces(mesh: &mut GradientMesh, faces: &[u32]) -> Result<(), String> {
 }
 
 /// Removes `faces`, the points in `points`, and every point no face uses any more; numbers the
-/// rest in order and carries handles, edge tags and side colours over to the new numbers.
+/// rest in order and carries handles, edge tags, sides and multi-resolution edits over to the
+/// new numbers. Sides and edits on removed faces are dropped.
 fn remove_faces_and_points(
     mesh: &mut GradientMesh,
     faces: &[u32],
     points: &[u32],
 ) -> Result<(), String> {
-    if !mesh.edits.is_empty() {
-        return Err(
-            "this layer has multi-resolution edits, which name faces by number: remove them before deleting".into(),
-        );
-    }
     let kept_faces: Vec<Vec<u32>> = (mesh.faces.iter().enumerate())
         .filter(|(f, _)| !faces.contains(&(*f as u32)))
         .map(|(_, corners)| corners.clone())
@@ -780,6 +792,19 @@ fn remove_faces_and_points(
                 .map(|(n, h)| (renumber(n), h))
                 .collect();
             Some(w)
+        })
+        .collect();
+    // An edit names a vertex by a face, one of its corners and a place in that corner's
+    // sector: a kept face keeps its corners in order, so only the numbers change.
+    mesh.edits = std::mem::take(&mut mesh.edits)
+        .into_iter()
+        .filter_map(|mut e| {
+            let face = old_faces
+                .iter()
+                .position(|&f| f == e.address.face as usize)?;
+            e.address.face = face as u32;
+            e.address.point = renumber(e.address.point);
+            Some(e)
         })
         .collect();
     Ok(())

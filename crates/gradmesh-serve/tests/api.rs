@@ -594,3 +594,84 @@ async fn a_side_of_a_discontinuity_takes_its_own_opacity_and_undoes() {
     assert_eq!(status, 422, "{text}");
     assert!(text.contains("not a corner of face 1"), "{text}");
 }
+
+/// Three squares in a row (faces 0, 1, 2 from the left), with a colour edit in face 0 and a
+/// colour and position edit at the far right corner of face 2.
+const STRIP: &str = r##"{"format":"gradmesh","version":1,"layers":[{"name":"strip","points":[
+  {"position":[0,0],"colour":"#d04020"},{"position":[100,0],"colour":"#e0c030"},
+  {"position":[200,0],"colour":"#2060c0"},{"position":[300,0],"colour":"#40a040"},
+  {"position":[0,100],"colour":"#802080"},{"position":[100,100],"colour":"#208080"},
+  {"position":[200,100],"colour":"#a0a0a0"},{"position":[300,100],"colour":"#f08000"}],
+  "faces":[[0,1,5,4],[1,2,6,5],[2,3,7,6]],
+  "edits":[{"level":2,"face":0,"point":0,"at":[1,1],"colour":"#ffffff"},
+    {"level":2,"face":2,"point":3,"at":[1,2],"colour":"#000000","offset":[0.4,-0.3]}]}]}"##;
+
+async fn refined_vertex(running: &Running, face: u32, point: u32, at: [u32; 2]) -> [f64; 2] {
+    let target = format!(
+        "/api/refined?token={}&layer=0&face={face}&level=2",
+        running.token
+    );
+    let (status, text) = get(running, &target).await;
+    assert_eq!(status, 200, "{text}");
+    let vertices: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let v = (vertices.as_array().unwrap().iter())
+        .find(|v| v["point"] == point && v["at"] == serde_json::json!(at))
+        .expect("the vertex is listed");
+    [
+        v["position"][0].as_f64().unwrap(),
+        v["position"][1].as_f64().unwrap(),
+    ]
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn deleting_faces_renumbers_the_edits_and_drops_those_on_deleted_faces() {
+    let (running, dir) = serve_square().await;
+    std::fs::write(dir.path().join("strip.json"), STRIP).unwrap();
+    assert_eq!(
+        command(&running, r#"{"type":"open","name":"strip.json"}"#)
+            .await
+            .0,
+        200
+    );
+    let before = document(&running).await.layers.remove(0);
+    let moved = refined_vertex(&running, 2, 3, [1, 2]).await;
+    let delete = serde_json::json!({"op": "delete_faces", "layer": 0, "faces": [0]});
+    let (status, state) = edit_command(&running, delete, None).await;
+    assert_eq!(status, 200, "{state}");
+    let state: serde_json::Value = serde_json::from_str(&state).unwrap();
+    assert_eq!(
+        state["notices"],
+        serde_json::json!(["1 multi-resolution edit on the deleted faces went with them"])
+    );
+    // Points 0 and 4 went with face 0: point 3 is now 2, face 2 is now 1.
+    let after = document(&running).await.layers.remove(0);
+    assert_eq!(after.edits.len(), 1);
+    let edit = &after.edits[0];
+    let address = (
+        edit.address.level,
+        edit.address.face,
+        edit.address.point,
+        edit.address.at,
+    );
+    assert_eq!(address, (2, 1, 2, [1, 2]));
+    assert_eq!(
+        (edit.colour, edit.offset),
+        (before.edits[1].colour, before.edits[1].offset)
+    );
+    // It names the same vertex: far from the deleted face, it is where it was.
+    assert_near(refined_vertex(&running, 1, 2, [1, 2]).await, moved);
+    // Undo brings the face and both edits back.
+    assert_eq!(command(&running, r#"{"type":"undo"}"#).await.0, 200);
+    assert_eq!(document(&running).await.layers[0], before);
+    // Deleting a point deletes its faces and their edits alike.
+    let delete = serde_json::json!({"op": "delete_points", "layer": 0, "points": [7]});
+    let (status, state) = edit_command(&running, delete, None).await;
+    assert_eq!(status, 200, "{state}");
+    assert!(
+        state.contains("1 multi-resolution edit on the deleted faces"),
+        "{state}"
+    );
+    let after = document(&running).await.layers.remove(0);
+    assert_eq!(after.faces.len(), 2);
+    assert_eq!(after.edits, before.edits[..1].to_vec());
+}
