@@ -548,6 +548,30 @@ async fn run_session(client: &Client, running: &Running, file: &Path) -> Result<
         differing_pixels(&recoloured.2, &refined.2) > 20,
         "moving the refined vertex changed the picture"
     );
+
+    // The opacity of one side of the discontinuity at point 8: the side in face 7 (selected
+    // here by script: point 8, then face 7, as a click and a Shift+click inside it would).
+    js(
+        client,
+        "const g = window.gradmesh; g.selection = [8]; g.face = 7; g.edge = null; return 0;",
+    )
+    .await;
+    type_into(client, "side-opacity", "0.2").await?;
+    click_id(client, "side-opacity-set").await?;
+    settle(client).await;
+    let sides = js(client, "return window.gradmesh.state.layers[0].sides;").await;
+    assert!(
+        sides
+            .as_array()
+            .unwrap()
+            .contains(&json!([8, 7, "#6a4c93", 0.2])),
+        "the side has its opacity: {sides}"
+    );
+    let side_faded = canvas_pixels(client).await;
+    assert!(
+        differing_pixels(&refined.2, &side_faded.2) > 100,
+        "the side's opacity changed the picture"
+    );
     screenshot(client, "editor-edited.png").await;
 
     // Save (Ctrl+S), and compare the canvas with gradmesh's render of the saved file.
@@ -564,7 +588,16 @@ async fn run_session(client: &Client, running: &Running, file: &Path) -> Result<
     assert_eq!(layer.edits.len(), 1, "the saved file has the refined edit");
     assert_eq!(layer.edge_tag(7, 12).kind, gradmesh::EdgeKind::Crease);
     assert_eq!(layer.points[7].colour_text.as_deref(), Some("#ff00ff"));
-    let worst = compare_with_render(client, file, &refined).await;
+    assert_eq!(
+        layer
+            .wedges
+            .iter()
+            .find(|w| (w.point, w.face) == (8, 7))
+            .unwrap()
+            .opacity,
+        Some(0.2)
+    );
+    let worst = compare_with_render(client, file, &side_faded).await;
     assert!(
         worst <= 2,
         "the canvas differs from the render of the saved file by {worst} levels"
