@@ -524,8 +524,9 @@ fn set_colour(
     Ok(())
 }
 
-/// The index in `mesh.wedges` of the entry of the side of `point` named by `face`, if it has
-/// one; fails if the point or face does not exist or the face does not hold the point.
+/// The index in `mesh.wedges` of the entry of the side of `point` that holds `face`, if it has
+/// one (the entry may name any face of that side); fails if the point or face does not exist or
+/// the face does not hold the point.
 fn side_entry(mesh: &mut GradientMesh, point: u32, face: u32) -> Result<Option<usize>, String> {
     point_mut(mesh, point)?;
     let corners = mesh
@@ -535,7 +536,37 @@ fn side_entry(mesh: &mut GradientMesh, point: u32, face: u32) -> Result<Option<u
     if !corners.contains(&point) {
         return Err(format!("point {point} is not a corner of face {face}"));
     }
-    Ok((mesh.wedges.iter()).position(|w| w.point == point && w.face == face))
+    let side = wedge_faces(mesh, point, face);
+    Ok((mesh.wedges.iter()).position(|w| w.point == point && side.contains(&w.face)))
+}
+
+/// The faces around `point` on the same side of its discontinuous edges as `face` (its wedge):
+/// those reached from `face` across edges at `point` that are not discontinuous.
+fn wedge_faces(mesh: &GradientMesh, point: u32, face: u32) -> Vec<u32> {
+    // The neighbours of `point` along the edges of face `f`.
+    let neighbours = |f: u32| {
+        let corners = &mesh.faces[f as usize];
+        let n = corners.len();
+        let i = corners.iter().position(|&c| c == point);
+        i.map(|i| [corners[(i + 1) % n], corners[(i + n - 1) % n]])
+    };
+    let mut side = vec![face];
+    let mut next = 0;
+    while next < side.len() {
+        let f = side[next];
+        next += 1;
+        for q in neighbours(f).into_iter().flatten() {
+            if mesh.edge_tag(point, q).kind == EdgeKind::Discontinuous {
+                continue;
+            }
+            for g in 0..mesh.faces.len() as u32 {
+                if !side.contains(&g) && neighbours(g).is_some_and(|ns| ns.contains(&q)) {
+                    side.push(g);
+                }
+            }
+        }
+    }
+    side
 }
 
 fn set_side_opacity(

@@ -675,3 +675,52 @@ async fn deleting_faces_renumbers_the_edits_and_drops_those_on_deleted_faces() {
     assert_eq!(after.faces.len(), 2);
     assert_eq!(after.edits, before.edits[..1].to_vec());
 }
+
+/// A 2 x 2 grid of squares whose middle column line (points 1, 4, 7) is discontinuous: point 4
+/// has two sides, faces 0 and 2 on the left, 1 and 3 on the right.
+const GRID: &str = r##"{"format":"gradmesh","version":1,"layers":[{"name":"grid","points":[
+  {"position":[0,0],"colour":"#d04020"},{"position":[100,0],"colour":"#e0c030"},
+  {"position":[200,0],"colour":"#2060c0"},{"position":[0,100],"colour":"#40a040"},
+  {"position":[100,100],"colour":"#802080"},{"position":[200,100],"colour":"#208080"},
+  {"position":[0,200],"colour":"#a0a0a0"},{"position":[100,200],"colour":"#f08000"},
+  {"position":[200,200],"colour":"#104010"}],
+  "faces":[[0,1,4,3],[1,2,5,4],[3,4,7,6],[4,5,8,7]],
+  "edges":[{"points":[1,4],"kind":"discontinuous"},{"points":[4,7],"kind":"discontinuous"}]}]}"##;
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_side_is_found_through_any_of_its_faces() {
+    let (running, dir) = serve_square().await;
+    std::fs::write(dir.path().join("grid.json"), GRID).unwrap();
+    assert_eq!(
+        command(&running, r#"{"type":"open","name":"grid.json"}"#)
+            .await
+            .0,
+        200
+    );
+    let op = |name: &str, face: u32, field: (&str, serde_json::Value)| {
+        let mut op = serde_json::json!({"op": name, "layer": 0, "point": 4, "face": face});
+        op[field.0] = field.1;
+        op
+    };
+    let opacity = op("set_side_opacity", 1, ("opacity", 0.5.into()));
+    assert_eq!(edit_command(&running, opacity, None).await.0, 200);
+    // Face 3 is on the same side as face 1: the same entry takes the colour.
+    let colour = op("set_side_colour", 3, ("css", "#00ff00".into()));
+    let (status, text) = edit_command(&running, colour, None).await;
+    assert_eq!(status, 200, "{text}");
+    let sides = document(&running).await.layers.remove(0).wedges;
+    assert_eq!(sides.len(), 1);
+    assert_eq!((sides[0].face, sides[0].opacity), (1, Some(0.5)));
+    assert_eq!(sides[0].colour_text.as_deref(), Some("#00ff00"));
+    // Face 2 is on the other side: a second entry.
+    let opacity = op("set_side_opacity", 2, ("opacity", 0.25.into()));
+    assert_eq!(edit_command(&running, opacity, None).await.0, 200);
+    let sides = document(&running).await.layers.remove(0).wedges;
+    let named: Vec<_> = sides.iter().map(|w| (w.face, w.opacity)).collect();
+    assert_eq!(named, vec![(1, Some(0.5)), (2, Some(0.25))]);
+    // Clearing through face 0 removes the left side's entry.
+    let clear = serde_json::json!({"op": "set_side_colour", "layer": 0, "point": 4, "face": 0});
+    assert_eq!(edit_command(&running, clear, None).await.0, 200);
+    let sides = document(&running).await.layers.remove(0).wedges;
+    assert_eq!(sides.iter().map(|w| w.face).collect::<Vec<_>>(), vec![1]);
+}
