@@ -110,7 +110,7 @@ pub fn offset_for_move(
     let along_u = limit_with(start + Vec2::new(1.0, 0.0))? - here;
     let along_v = limit_with(start + Vec2::new(0.0, 1.0))? - here;
     let det = along_u.cross(along_v);
-    if det.abs() <= 1e-12 * along_u.hypot() * along_v.hypot() || det == 0.0 {
+    if det.abs() <= 1e-12 * along_u.hypot() * along_v.hypot() {
         return Err(format!(
             "the refined vertex {address} cannot be moved: its frame is degenerate"
         ));
