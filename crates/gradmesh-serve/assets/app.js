@@ -85,7 +85,7 @@ function receiveText(message) {
   if (message.type === "done") {
     editor.busy = false;
     flush();
-  } else if (message.type === "error") {
+  } else if (message.type === "error" || message.type === "notice") {
     showMessage(message.message);
   } else if (message.type === "state") {
     const first = editor.state === null;
@@ -331,13 +331,18 @@ function drawRefined(c) {
   }
 }
 
-// Fetches the refined vertices of a face at a level, with their addresses.
+// Fetches the refined vertices of a face at a level, with their addresses. Only the answer to
+// the latest request is shown (answers to earlier ones may come after it).
+let refinedRequests = 0;
 async function loadRefined(layer, face, level) {
+  const request = ++refinedRequests;
   const query = `token=${encodeURIComponent(token)}&layer=${layer}&face=${face}&level=${level}`;
   const response = await fetch(`/api/refined?${query}`);
-  if (!response.ok) { showMessage(await response.text()); editor.refined = null; drawOverlay(); return; }
+  const text = await response.text();
+  if (request !== refinedRequests) return;
+  if (!response.ok) { showMessage(text); editor.refined = null; drawOverlay(); return; }
   const chosen = editor.refined && editor.refined.chosen;
-  const vertices = await response.json();
+  const vertices = JSON.parse(text);
   editor.refined = { layer, face, level, vertices, chosen: null };
   if (chosen) {
     editor.refined.chosen = vertices.find((v) => v.point === chosen.point && v.at[0] === chosen.at[0] && v.at[1] === chosen.at[1]) || null;
@@ -453,6 +458,8 @@ overlay.addEventListener("pointerdown", (event) => {
     $("mr-point").value = refined.point;
     $("mr-i").value = refined.at[0];
     $("mr-j").value = refined.at[1];
+    editor.drag = { kind: "refined", start: at, gesture: editor.nextGesture++, vertex: refined,
+      origin: [...refined.position], layer: editor.refined.layer, face: editor.refined.face, level: editor.refined.level };
     drawOverlay();
     return;
   }
@@ -482,9 +489,11 @@ overlay.addEventListener("pointerdown", (event) => {
 });
 
 overlay.addEventListener("pointermove", (event) => {
-  const d = editor.drag;
-  if (!d) return;
-  const at = eventPosition(event);
+  if (editor.drag) dragTo(editor.drag, eventPosition(event));
+});
+
+// Follows a drag to `at` (screen pixels of the overlay).
+function dragTo(d, at) {
   const s = scale();
   const [dx, dy] = [(at[0] - d.start[0]) / s, (at[1] - d.start[1]) / s];
   const layer = activeLayer();
@@ -504,19 +513,27 @@ overlay.addEventListener("pointermove", (event) => {
     layer.handles = layer.handles.map((h) => (h[0] === from && h[1] === to ? [from, to, x, y] : h));
     edit({ op: "set_handle", layer: editor.activeLayer, from, to, x, y }, d.gesture);
     drawOverlay();
+  } else if (d.kind === "refined") {
+    // The server sets the vertex's position offset so that its limit position moves by this.
+    d.moved = true;
+    d.vertex.position = [d.origin[0] + dx, d.origin[1] + dy];
+    edit({ op: "move_refined_vertex", layer: d.layer, level: d.level, face: d.face,
+      point: d.vertex.point, at: d.vertex.at, dx, dy }, d.gesture);
+    drawOverlay();
   } else if (d.kind === "box") {
     d.at = at;
     drawOverlay();
   }
-});
+}
 
 overlay.addEventListener("pointerup", (event) => {
   const d = editor.drag;
   editor.drag = null;
   if (!d) return;
   const at = eventPosition(event);
-  if (d.kind === "points" || d.kind === "handle") {
-    if (d.moved) send({ type: "end_gesture" });
+  if (d.kind === "points" || d.kind === "handle" || d.kind === "refined") {
+    // The last move event may not be where the button went up.
+    if (d.moved) { dragTo(d, at); send({ type: "end_gesture" }); }
   } else if (d.kind === "box") {
     finishBox(d, at);
   }
@@ -712,22 +729,40 @@ $("layer-delete").onclick = () => {
 };
 $("side-colour").onclick = () => sideColour($("colour-picker").value);
 $("side-clear").onclick = () => sideColour(null);
+$("side-opacity-set").onclick = sideOpacity;
 $("mr-show").onclick = () => {
   if (editor.face === null) { showMessage("Select a face first (click inside it)."); return; }
   loadRefined(editor.activeLayer, editor.face, Number($("mr-level").value));
 };
-$("mr-hide").onclick = () => { editor.refined = null; drawOverlay(); };
+$("mr-hide").onclick = () => { refinedRequests++; editor.refined = null; drawOverlay(); };
 $("mr-set").onclick = () => refinedEdit(true);
 $("mr-clear").onclick = () => refinedEdit(false);
 
-// The colour of the selected point on the side of the selected face (at a discontinuity).
-function sideColour(css) {
+// The selected point and the selected face around it: a side of a discontinuity, or null.
+function selectedSide() {
   if (editor.selection.length !== 1 || editor.face === null) {
     showMessage("Select one point, then Shift+click inside a face around it.");
-    return;
+    return null;
   }
-  const op = { op: "set_side_colour", layer: editor.activeLayer, point: editor.selection[0], face: editor.face };
+  return { layer: editor.activeLayer, point: editor.selection[0], face: editor.face };
+}
+
+// The colour of the selected point on the side of the selected face (at a discontinuity).
+function sideColour(css) {
+  const side = selectedSide();
+  if (!side) return;
+  const op = { op: "set_side_colour", ...side };
   if (css) op.css = css;
+  edit(op);
+}
+
+// The opacity of that side; an empty field gives it the point's opacity again.
+function sideOpacity() {
+  const side = selectedSide();
+  if (!side) return;
+  const op = { op: "set_side_opacity", ...side };
+  const text = $("side-opacity").value.trim();
+  if (text !== "") op.opacity = Number(text);
   edit(op);
 }
 
@@ -798,9 +833,10 @@ function updatePanels() {
       $("sharpness").value = tag[3] === null ? "" : tag[3];
     }
   }
-  $("mr-list").replaceChildren(...(layer ? layer.edits : []).map(([level, face, point, at]) => {
+  $("mr-list").replaceChildren(...(layer ? layer.edits : []).map(([level, face, point, at, offset]) => {
     const item = document.createElement("li");
-    item.textContent = `level ${level}, face ${face}, corner ${point}, at ${at.join(",")}`;
+    const moved = offset ? `, moved ${offset.map((o) => o.toFixed(3)).join(",")}` : "";
+    item.textContent = `level ${level}, face ${face}, corner ${point}, at ${at.join(",")}${moved}`;
     return item;
   }));
   updateWarnings(state);
@@ -843,6 +879,8 @@ function updatePointPanel(layer) {
   ["c0", "c1", "c2"].forEach((id, k) => { if (active !== $(id)) $(id).value = +layer.colours[p][k].toFixed(4); });
   if (active !== $("opacity")) $("opacity").value = layer.opacity[p];
   $("opacity-value").textContent = layer.opacity[p].toFixed(2);
+  const side = layer.sides.find(([q, f]) => q === p && f === editor.face);
+  if (active !== $("side-opacity")) $("side-opacity").value = side && side[3] !== null ? side[3] : "";
 }
 
 function updateWarnings(state) {

@@ -45,16 +45,17 @@ impl History {
         &self.current
     }
 
-    /// Applies `op`, as part of `gesture` if given. The result must pass the validator (every
-    /// layer); else the picture stays as it was and the validator's message is returned.
-    pub fn apply(&mut self, op: &Op, gesture: Option<u64>) -> Result<(), String> {
+    /// Applies `op`, as part of `gesture` if given, and returns its note for the user (see
+    /// [`Op::apply`]). The result must pass the validator (every layer); else the picture stays
+    /// as it was and the validator's message is returned.
+    pub fn apply(&mut self, op: &Op, gesture: Option<u64>) -> Result<Option<String>, String> {
         let continuing = gesture.is_some() && gesture == self.gesture && !self.undo.is_empty();
         let mut next = if continuing {
             self.undo.last().expect("a gesture has its start").clone()
         } else {
             self.current.clone()
         };
-        op.apply(&mut next)?;
+        let note = op.apply(&mut next)?;
         check_picture(&next, Some(&self.current))?;
         if !continuing {
             self.undo.push(std::mem::replace(&mut self.current, next));
@@ -67,7 +68,7 @@ impl History {
         self.redo.clear();
         self.gesture = gesture;
         self.version += 1;
-        Ok(())
+        Ok(note)
     }
 
     /// Ends the open gesture: the next edit starts a new step.

@@ -5,7 +5,8 @@
 //! refuses it whole if any layer is invalid.
 
 use gradmesh::{
-    parse_css_colour, ColourSpace, Document, EdgeKind, Edit, GradientMesh, SHARPNESS_INFINITE,
+    parse_css_colour, ColourSpace, Document, EdgeKind, Edit, GradientMesh, VertexAddress,
+    SHARPNESS_INFINITE,
 };
 use kurbo::{CubicBez, ParamCurve, Point, Vec2};
 use serde::Deserialize;
@@ -209,7 +210,23 @@ pub enum Op {
         #[serde(default)]
         css: Option<String>,
     },
-    /// Sets or removes the multi-resolution colour and opacity edit of a refined vertex.
+    /// Sets the opacity of one side of a discontinuity: of `point` in the wedge of faces that
+    /// holds `face`. A side without its own entry gets one with the point's colour (the format
+    /// requires a side's colour). No `opacity`: the side takes the point's opacity again.
+    SetSideOpacity {
+        /// The layer.
+        layer: usize,
+        /// The point on the discontinuous edge.
+        point: u32,
+        /// A face around the point, on the side to change.
+        face: u32,
+        /// Opacity in 0..=1.
+        #[serde(default)]
+        opacity: Option<f64>,
+    },
+    /// Sets or removes the multi-resolution edit of a refined vertex: its colour and opacity
+    /// are replaced, its position offset is replaced if given and kept if not. Neither colour,
+    /// opacity nor offset: the edit is removed.
     SetRefinedEdit {
         /// The layer.
         layer: usize,
@@ -227,20 +244,43 @@ pub enum Op {
         /// New opacity (absent: no opacity edit).
         #[serde(default)]
         opacity: Option<f64>,
+        /// New position offset `[u, v]` in the vertex's frame (absent: the edit's offset stays).
+        #[serde(default)]
+        offset: Option<[f64; 2]>,
+    },
+    /// Moves a refined vertex: sets its edit's position offset so that its limit position moves
+    /// by `(dx, dy)` from where it is. Refused on a layer that allows colour edits only.
+    MoveRefinedVertex {
+        /// The layer.
+        layer: usize,
+        /// Level of the refined vertex (1 or more).
+        level: u32,
+        /// The control face it lies in.
+        face: u32,
+        /// The corner of that face whose sector holds it.
+        point: u32,
+        /// Its place in the sector's grid.
+        at: [u32; 2],
+        /// The move in x.
+        dx: f64,
+        /// The move in y.
+        dy: f64,
     },
 }
 
 impl Op {
-    /// Applies the edit to `picture`. Fails with a message for the user when the edit names
-    /// nothing that exists or makes no sense; the validity of the result is checked apart.
-    pub fn apply(&self, picture: &mut Picture) -> Result<(), String> {
+    /// Applies the edit to `picture`; returns a note for the user when the edit did more than
+    /// asked (a deletion that dropped multi-resolution edits). Fails with a message for the
+    /// user when the edit names nothing that exists or makes no sense; the validity of the
+    /// result is checked apart.
+    pub fn apply(&self, picture: &mut Picture) -> Result<Option<String>, String> {
         match self {
             Op::AddLayer { name } => {
                 let mut mesh = GradientMesh::new(ColourSpace::Lab);
                 mesh.name = name.clone();
                 picture.doc.layers.push(mesh);
                 picture.hidden.push(false);
-                Ok(())
+                Ok(None)
             }
             Op::MoveLayer { layer, to } => {
                 check_layer(picture, *layer)?;
@@ -249,28 +289,42 @@ impl Op {
                 let hidden = picture.hidden.remove(*layer);
                 picture.doc.layers.insert(*to, mesh);
                 picture.hidden.insert(*to, hidden);
-                Ok(())
+                Ok(None)
             }
             Op::SetLayerHidden { layer, hidden } => {
                 check_layer(picture, *layer)?;
                 picture.hidden[*layer] = *hidden;
-                Ok(())
+                Ok(None)
             }
             Op::RenameLayer { layer, name } => {
                 check_layer(picture, *layer)?;
                 picture.doc.layers[*layer].name = (!name.is_empty()).then(|| name.clone());
-                Ok(())
+                Ok(None)
             }
             Op::DeleteLayer { layer } => {
                 check_layer(picture, *layer)?;
                 picture.doc.layers.remove(*layer);
                 picture.hidden.remove(*layer);
-                Ok(())
+                Ok(None)
+            }
+            Op::DeletePoints { layer, .. } | Op::DeleteFaces { layer, .. } => {
+                check_layer(picture, *layer)?;
+                let mesh = &mut picture.doc.layers[*layer];
+                let edits = mesh.edits.len();
+                self.apply_to_mesh(mesh)?;
+                let dropped = edits - mesh.edits.len();
+                Ok((dropped > 0).then(|| {
+                    format!(
+                        "{dropped} multi-resolution edit{} on the deleted faces went with them",
+                        if dropped == 1 { "" } else { "s" }
+                    )
+                }))
             }
             _ => {
                 let layer = self.layer();
                 check_layer(picture, layer)?;
-                self.apply_to_mesh(&mut picture.doc.layers[layer])
+                self.apply_to_mesh(&mut picture.doc.layers[layer])?;
+                Ok(None)
             }
         }
     }
@@ -294,7 +348,9 @@ impl Op {
             | Op::RenameLayer { layer, .. }
             | Op::DeleteLayer { layer }
             | Op::SetSideColour { layer, .. }
-            | Op::SetRefinedEdit { layer, .. } => *layer,
+            | Op::SetSideOpacity { layer, .. }
+            | Op::SetRefinedEdit { layer, .. }
+            | Op::MoveRefinedVertex { layer, .. } => *layer,
             Op::AddLayer { .. } => 0,
         }
     }
@@ -341,6 +397,12 @@ impl Op {
                 css,
                 ..
             } => set_side_colour(mesh, *point, *face, *colour, css.as_deref()),
+            Op::SetSideOpacity {
+                point,
+                face,
+                opacity,
+                ..
+            } => set_side_opacity(mesh, *point, *face, *opacity),
             Op::SplitFace { face, a, b, .. } => split_face(mesh, *face, *a, *b),
             Op::AddFace { points, .. } => {
                 for &p in points {
@@ -362,15 +424,24 @@ impl Op {
                 at,
                 colour,
                 opacity,
+                offset,
                 ..
             } => {
-                let address = gradmesh::VertexAddress {
-                    level: *level,
-                    face: *face,
-                    point: *point,
-                    at: *at,
-                };
-                set_refined_edit(mesh, address, *colour, *opacity)
+                let address = VertexAddress::new(*level, *face, *point, *at);
+                let offset = offset.map(|[u, v]| Vec2::new(u, v));
+                set_refined_edit(mesh, address, *colour, *opacity, offset)
+            }
+            Op::MoveRefinedVertex {
+                level,
+                face,
+                point,
+                at,
+                dx,
+                dy,
+                ..
+            } => {
+                let address = VertexAddress::new(*level, *face, *point, *at);
+                move_refined_vertex(mesh, address, Vec2::new(*dx, *dy))
             }
             Op::AddLayer { .. }
             | Op::MoveLayer { .. }
@@ -453,13 +524,10 @@ fn set_colour(
     Ok(())
 }
 
-fn set_side_colour(
-    mesh: &mut GradientMesh,
-    point: u32,
-    face: u32,
-    colour: Option<[f64; 3]>,
-    css: Option<&str>,
-) -> Result<(), String> {
+/// The index in `mesh.wedges` of the entry of the side of `point` that holds `face`, if it has
+/// one (the entry may name any face of that side); fails if the point or face does not exist or
+/// the face does not hold the point.
+fn side_entry(mesh: &mut GradientMesh, point: u32, face: u32) -> Result<Option<usize>, String> {
     point_mut(mesh, point)?;
     let corners = mesh
         .faces
@@ -468,7 +536,72 @@ fn set_side_colour(
     if !corners.contains(&point) {
         return Err(format!("point {point} is not a corner of face {face}"));
     }
-    let existing = (mesh.wedges.iter()).position(|w| w.point == point && w.face == face);
+    let side = wedge_faces(mesh, point, face);
+    Ok((mesh.wedges.iter()).position(|w| w.point == point && side.contains(&w.face)))
+}
+
+/// The faces around `point` on the same side of its discontinuous edges as `face` (its wedge):
+/// those reached from `face` across edges at `point` that are not discontinuous.
+fn wedge_faces(mesh: &GradientMesh, point: u32, face: u32) -> Vec<u32> {
+    // The neighbours of `point` along the edges of face `f`.
+    let neighbours = |f: u32| {
+        let corners = &mesh.faces[f as usize];
+        let n = corners.len();
+        let i = corners.iter().position(|&c| c == point);
+        i.map(|i| [corners[(i + 1) % n], corners[(i + n - 1) % n]])
+    };
+    let mut side = vec![face];
+    let mut next = 0;
+    while next < side.len() {
+        let f = side[next];
+        next += 1;
+        for q in neighbours(f).into_iter().flatten() {
+            if mesh.edge_tag(point, q).kind == EdgeKind::Discontinuous {
+                continue;
+            }
+            for g in 0..mesh.faces.len() as u32 {
+                if !side.contains(&g) && neighbours(g).is_some_and(|ns| ns.contains(&q)) {
+                    side.push(g);
+                }
+            }
+        }
+    }
+    side
+}
+
+fn set_side_opacity(
+    mesh: &mut GradientMesh,
+    point: u32,
+    face: u32,
+    opacity: Option<f64>,
+) -> Result<(), String> {
+    let existing = side_entry(mesh, point, face)?;
+    match (existing, opacity) {
+        (Some(i), _) => mesh.wedges[i].opacity = opacity,
+        (None, None) => {}
+        (None, Some(_)) => {
+            let p = &mesh.points[point as usize];
+            mesh.wedges.push(gradmesh::WedgeOverride {
+                point,
+                face,
+                colour: p.colour,
+                colour_text: p.colour_text.clone(),
+                opacity,
+                handles: Default::default(),
+            });
+        }
+    }
+    Ok(())
+}
+
+fn set_side_colour(
+    mesh: &mut GradientMesh,
+    point: u32,
+    face: u32,
+    colour: Option<[f64; 3]>,
+    css: Option<&str>,
+) -> Result<(), String> {
+    let existing = side_entry(mesh, point, face)?;
     if colour.is_none() && css.is_none() {
         if let Some(i) = existing {
             mesh.wedges.remove(i);
@@ -626,17 +759,13 @@ fn delete_faces(mesh: &mut GradientMesh, faces: &[u32]) -> Result<(), String> {
 }
 
 /// Removes `faces`, the points in `points`, and every point no face uses any more; numbers the
-/// rest in order and carries handles, edge tags and side colours over to the new numbers.
+/// rest in order and carries handles, edge tags, sides and multi-resolution edits over to the
+/// new numbers. Sides and edits on removed faces are dropped.
 fn remove_faces_and_points(
     mesh: &mut GradientMesh,
     faces: &[u32],
     points: &[u32],
 ) -> Result<(), String> {
-    if !mesh.edits.is_empty() {
-        return Err(
-            "this layer has multi-resolution edits, which name faces by number: remove them before deleting".into(),
-        );
-    }
     let kept_faces: Vec<Vec<u32>> = (mesh.faces.iter().enumerate())
         .filter(|(f, _)| !faces.contains(&(*f as u32)))
         .map(|(_, corners)| corners.clone())
@@ -696,27 +825,54 @@ fn remove_faces_and_points(
             Some(w)
         })
         .collect();
+    // An edit names a vertex by a face, one of its corners and a place in that corner's
+    // sector: a kept face keeps its corners in order, so only the numbers change.
+    mesh.edits = std::mem::take(&mut mesh.edits)
+        .into_iter()
+        .filter_map(|mut e| {
+            let face = old_faces
+                .iter()
+                .position(|&f| f == e.address.face as usize)?;
+            e.address.face = face as u32;
+            e.address.point = renumber(e.address.point);
+            Some(e)
+        })
+        .collect();
     Ok(())
 }
 
 fn set_refined_edit(
     mesh: &mut GradientMesh,
-    address: gradmesh::VertexAddress,
+    address: VertexAddress,
     colour: Option<[f64; 3]>,
     opacity: Option<f64>,
+    offset: Option<Vec2>,
 ) -> Result<(), String> {
-    if colour.is_none() && opacity.is_none() {
+    if colour.is_none() && opacity.is_none() && offset.is_none() {
         mesh.remove_edit(&address);
         return Ok(());
     }
-    let mut edit = mesh.edit(&address).cloned().unwrap_or(Edit {
-        address,
-        colour: None,
-        opacity: None,
-        offset: None,
-    });
+    let mut edit = (mesh.edit(&address).cloned()).unwrap_or_else(|| Edit::new(address));
     edit.colour = colour.map(gradmesh::ColourEdit::Set);
     edit.opacity = opacity.map(gradmesh::OpacityEdit::Set);
+    if offset.is_some() {
+        edit.offset = offset;
+    }
+    mesh.set_edit(edit);
+    Ok(())
+}
+
+fn move_refined_vertex(
+    mesh: &mut GradientMesh,
+    address: VertexAddress,
+    shift: Vec2,
+) -> Result<(), String> {
+    if !(shift.x.is_finite() && shift.y.is_finite()) {
+        return Err("a move must be finite numbers".into());
+    }
+    let offset = crate::refined::offset_for_move(mesh, address, shift)?;
+    let mut edit = (mesh.edit(&address).cloned()).unwrap_or_else(|| Edit::new(address));
+    edit.offset = Some(offset);
     mesh.set_edit(edit);
     Ok(())
 }

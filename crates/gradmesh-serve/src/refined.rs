@@ -2,6 +2,7 @@
 //! vertex of a multi-resolution edit on the page.
 
 use gradmesh::{Edit, GradientMesh, Refinement, VertexAddress, MAX_EDIT_LEVEL};
+use kurbo::Vec2;
 use serde::Serialize;
 
 /// The deepest level whose vertices the page can show (a sector then has 12 x 12 quads).
@@ -20,7 +21,7 @@ pub struct RefinedVertex {
 
 /// Every vertex of the sectors of `face` at `level`, named through each sector (a vertex on a
 /// sector's side appears once per sector that names it). Positions are those of the limit
-/// surface without the layer's edits.
+/// surface with the layer's edits (a vertex moved by a position edit shows where it went).
 pub fn face_vertices(
     mesh: &GradientMesh,
     face: u32,
@@ -37,10 +38,8 @@ pub fn face_vertices(
     let mut plain = mesh.clone();
     plain.edits.clear();
     let (mut refinement, _) = Refinement::new(&plain, level as usize).map_err(|e| e.to_string())?;
-    let data = refinement.evaluate();
-    let limit = refinement.limit(&data, level as usize);
     let size = VertexAddress::sector_size(level);
-    let mut vertices = Vec::new();
+    let mut found = Vec::new();
     for &point in &corners {
         for i in 0..=size {
             for j in 0..=size {
@@ -49,16 +48,76 @@ pub fn face_vertices(
                     .set_edits(&[Edit::new(address)], plain.fine_edits)
                     .map_err(|e| e.to_string())?;
                 if let Some(v) = refinement.edited_vertex(0) {
-                    vertices.push(RefinedVertex {
-                        point,
-                        at: [i, j],
-                        position: [limit[v][0], limit[v][1]],
-                    });
+                    found.push((point, [i, j], v));
                 }
             }
         }
     }
-    Ok(vertices)
+    // The edits change no topology: a vertex has the same index with them.
+    refinement
+        .set_edits(&mesh.edits, mesh.fine_edits)
+        .map_err(|e| e.to_string())?;
+    let data = refinement.evaluate();
+    let limit = refinement.limit(&data, level as usize);
+    Ok(found
+        .into_iter()
+        .map(|(point, at, v)| RefinedVertex {
+            point,
+            at,
+            position: [limit[v][0], limit[v][1]],
+        })
+        .collect())
+}
+
+/// The position offset (in the vertex's frame, as `Edit::offset`) that moves the limit position
+/// of the refined vertex at `address` by `shift` from where it is with the layer's edits.
+///
+/// The limit position is an affine function of the offset (the frame is made of the level's
+/// edges before its edits, and subdivision is linear), so three evaluations give it exactly.
+/// Fails with the validator's message when the layer refuses position edits
+/// (`fine_edits: colour-only`), and when the frame is degenerate.
+pub fn offset_for_move(
+    mesh: &GradientMesh,
+    address: VertexAddress,
+    shift: Vec2,
+) -> Result<Vec2, String> {
+    let start = mesh
+        .edit(&address)
+        .and_then(|e| e.offset)
+        .unwrap_or(Vec2::ZERO);
+    let mut edits = mesh.edits.clone();
+    let index = match edits.iter().position(|e| e.address == address) {
+        Some(i) => i,
+        None => {
+            edits.push(Edit::new(address));
+            edits.len() - 1
+        }
+    };
+    let (mut refinement, _) =
+        Refinement::new(mesh, address.level as usize).map_err(|e| e.to_string())?;
+    let mut limit_with = |offset: Vec2| -> Result<Vec2, String> {
+        edits[index].offset = Some(offset);
+        refinement
+            .set_edits(&edits, mesh.fine_edits)
+            .map_err(|e| e.to_string())?;
+        let v = (refinement.edited_vertex(index))
+            .ok_or_else(|| format!("the address {address} names no vertex"))?;
+        let data = refinement.evaluate();
+        let limit = refinement.limit(&data, address.level as usize);
+        Ok(Vec2::new(limit[v][0], limit[v][1]))
+    };
+    let here = limit_with(start)?;
+    let along_u = limit_with(start + Vec2::new(1.0, 0.0))? - here;
+    let along_v = limit_with(start + Vec2::new(0.0, 1.0))? - here;
+    let det = along_u.cross(along_v);
+    if det.abs() <= 1e-12 * along_u.hypot() * along_v.hypot() {
+        return Err(format!(
+            "the refined vertex {address} cannot be moved: its frame is degenerate"
+        ));
+    }
+    let u = shift.cross(along_v) / det;
+    let v = along_u.cross(shift) / det;
+    Ok(start + Vec2::new(u, v))
 }
 
 #[cfg(test)]

@@ -102,9 +102,11 @@ async fn command(State(app): State<Arc<App>>, body: Bytes) -> Response {
     reply(run_blocking(app, vec![command]).await)
 }
 
-/// The answer of the HTTP API: the first error (422) or the state (200).
+/// The answer of the HTTP API: the first error (422) or the state (200), with the edits' notes
+/// in its `notices`.
 fn reply(messages: Vec<Outgoing>) -> Response {
     let mut state = None;
+    let mut notices = Vec::new();
     for message in messages {
         match message {
             Outgoing::Error(text) => {
@@ -116,11 +118,25 @@ fn reply(messages: Vec<Outgoing>) -> Response {
                     .into_response();
             }
             Outgoing::Text(text) => state = Some(text),
+            Outgoing::Notice(text) => notices.push(text),
             Outgoing::Binary(_) | Outgoing::Done => {}
         }
     }
     match state {
-        Some(text) => ([(header::CONTENT_TYPE, "application/json")], text).into_response(),
+        Some(text) if notices.is_empty() => {
+            ([(header::CONTENT_TYPE, "application/json")], text).into_response()
+        }
+        Some(text) => {
+            let mut state: serde_json::Value =
+                serde_json::from_str(&text).expect("the state is JSON");
+            let notes = notices.iter().map(|n| {
+                let notice: serde_json::Value = serde_json::from_str(n).expect("a notice is JSON");
+                notice["message"].clone()
+            });
+            state["notices"] = notes.collect();
+            let text = state.to_string();
+            ([(header::CONTENT_TYPE, "application/json")], text).into_response()
+        }
         None => (StatusCode::INTERNAL_SERVER_ERROR, "no state").into_response(),
     }
 }
@@ -240,7 +256,9 @@ async fn run_socket(socket: WebSocket, app: Arc<App>) {
         session = Some(back);
         for message in messages {
             let message = match message {
-                Outgoing::Text(text) | Outgoing::Error(text) => Message::Text(text.into()),
+                Outgoing::Text(text) | Outgoing::Error(text) | Outgoing::Notice(text) => {
+                    Message::Text(text.into())
+                }
                 Outgoing::Binary(bytes) => Message::Binary(bytes.into()),
                 Outgoing::Done => Message::Text(r#"{"type":"done"}"#.into()),
             };

@@ -81,6 +81,8 @@ pub enum Outgoing {
     Text(String),
     /// JSON: an error message.
     Error(String),
+    /// JSON: a note about an edit that was made (`{"type": "notice", "message": …}`).
+    Notice(String),
     /// A frame (see [`crate::viewer::encode_frame`]).
     Binary(Vec<u8>),
     /// The end of the answer to a batch of commands: the page may send the next batch.
@@ -132,8 +134,12 @@ impl Session {
     pub fn handle(&mut self, commands: &[Command]) -> Vec<Outgoing> {
         let mut out = Vec::new();
         for command in commands {
-            if let Err(message) = self.run(command) {
-                out.push(error_message(&message));
+            match self.run(command) {
+                Ok(Some(note)) => out.push(Outgoing::Notice(
+                    serde_json::json!({"type": "notice", "message": note}).to_string(),
+                )),
+                Ok(None) => {}
+                Err(message) => out.push(error_message(&message)),
             }
         }
         let doc = self.app.editor().history.current().visible();
@@ -173,12 +179,15 @@ impl Session {
         Some(status.to_json().to_string())
     }
 
-    /// Runs one command.
-    fn run(&mut self, command: &Command) -> Result<(), String> {
+    /// Runs one command; returns the edit's note for the user, if any.
+    fn run(&mut self, command: &Command) -> Result<Option<String>, String> {
         let app = Arc::clone(&self.app);
         let mut editor = app.editor();
-        match command {
-            Command::Edit { op, gesture } => editor.history.apply(op, *gesture),
+        let mut note = None;
+        let done = match command {
+            Command::Edit { op, gesture } => {
+                (editor.history.apply(op, *gesture)).map(|edit_note| note = edit_note)
+            }
             Command::State => Ok(()),
             Command::EndGesture => {
                 editor.history.end_gesture();
@@ -223,7 +232,8 @@ impl Session {
                 self.told_version = None;
                 Ok(())
             }
-        }
+        };
+        done.map(|()| note)
     }
 }
 
@@ -262,7 +272,7 @@ mod tests {
         for message in out {
             match message {
                 Outgoing::Binary(_) => n.0 += 1,
-                Outgoing::Text(_) => n.1 += 1,
+                Outgoing::Text(_) | Outgoing::Notice(_) => n.1 += 1,
                 Outgoing::Error(_) => n.2 += 1,
                 Outgoing::Done => n.3 += 1,
             }

@@ -135,14 +135,15 @@ fn layer_json(mesh: &GradientMesh, hidden: bool, folds: Option<&[[f64; 3]]>) -> 
                 e.address.level,
                 e.address.face,
                 e.address.point,
-                e.address.at
+                e.address.at,
+                e.offset.map(|o| [o.x, o.y]),
             ])
         })
         .collect();
     let sides: Vec<Value> = mesh
         .wedges
         .iter()
-        .map(|w| json!([w.point, w.face, srgb_hex(space, w.colour)]))
+        .map(|w| json!([w.point, w.face, srgb_hex(space, w.colour), w.opacity]))
         .collect();
     json!({
         "name": mesh.name,

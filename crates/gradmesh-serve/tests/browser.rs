@@ -203,6 +203,8 @@ async fn point_on_screen(client: &Client, p: usize) -> (f64, f64) {
     (at[0].as_f64().unwrap(), at[1].as_f64().unwrap())
 }
 
+/// Drags from `from` by `by` in ten steps; the driver moves by whole pixels, so `by` should be
+/// a multiple of ten.
 async fn drag(client: &Client, from: (f64, f64), by: (f64, f64)) {
     let mut mouse = MouseActions::new("mouse".into())
         .then(PointerAction::MoveTo {
@@ -500,14 +502,75 @@ async fn run_session(client: &Client, running: &Running, file: &Path) -> Result<
     let edits = js(client, "return window.gradmesh.state.layers[0].edits;").await;
     assert_eq!(
         edits,
-        json!([[2, 5, 7, [1, 1]]]),
+        json!([[2, 5, 7, [1, 1], null]]),
         "{}",
         js(client, "return window.gradmesh.error;").await
     );
+    let recoloured = canvas_pixels(client).await;
+    assert!(
+        differing_pixels(&creased.2, &recoloured.2) > 20,
+        "the refined edit changed the picture"
+    );
+
+    // Drag the same refined vertex: its edit gets a position offset, and its dot (the limit
+    // position, fetched again from the server) lands where the mouse let go.
+    let from = (dot[0].as_f64().unwrap(), dot[1].as_f64().unwrap());
+    drag(client, from, (30.0, 20.0)).await;
+    settle(client).await;
+    let target = (from.0.round() + 30.0, from.1.round() + 20.0);
+    let deadline = Instant::now() + Duration::from_secs(20);
+    loop {
+        let at = js(client, "const g = window.gradmesh; \
+            const v = g.refined.vertices.find(v => v.point === 7 && v.at[0] === 1 && v.at[1] === 1); \
+            const [x, y] = g.toScreen(...v.position); \
+            const r = document.getElementById('overlay').getBoundingClientRect(); return [r.left + x, r.top + y];").await;
+        let (x, y) = (at[0].as_f64().unwrap(), at[1].as_f64().unwrap());
+        if (x - target.0).hypot(y - target.1) < 1.0 {
+            break;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "the dragged refined vertex is at {x}, {y}, not {target:?}"
+        );
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    let offset = js(
+        client,
+        "return window.gradmesh.state.layers[0].edits[0][4];",
+    )
+    .await;
+    assert!(
+        offset.is_array(),
+        "the drag gave the edit an offset: {offset}"
+    );
     let refined = canvas_pixels(client).await;
     assert!(
-        differing_pixels(&creased.2, &refined.2) > 20,
-        "the refined edit changed the picture"
+        differing_pixels(&recoloured.2, &refined.2) > 20,
+        "moving the refined vertex changed the picture"
+    );
+
+    // The opacity of one side of the discontinuity at point 8: the side in face 7 (selected
+    // here by script: point 8, then face 7, as a click and a Shift+click inside it would).
+    js(
+        client,
+        "const g = window.gradmesh; g.selection = [8]; g.face = 7; g.edge = null; return 0;",
+    )
+    .await;
+    type_into(client, "side-opacity", "0.2").await?;
+    click_id(client, "side-opacity-set").await?;
+    settle(client).await;
+    let sides = js(client, "return window.gradmesh.state.layers[0].sides;").await;
+    assert!(
+        sides
+            .as_array()
+            .unwrap()
+            .contains(&json!([8, 7, "#6a4c93", 0.2])),
+        "the side has its opacity: {sides}"
+    );
+    let side_faded = canvas_pixels(client).await;
+    assert!(
+        differing_pixels(&refined.2, &side_faded.2) > 100,
+        "the side's opacity changed the picture"
     );
     screenshot(client, "editor-edited.png").await;
 
@@ -525,7 +588,16 @@ async fn run_session(client: &Client, running: &Running, file: &Path) -> Result<
     assert_eq!(layer.edits.len(), 1, "the saved file has the refined edit");
     assert_eq!(layer.edge_tag(7, 12).kind, gradmesh::EdgeKind::Crease);
     assert_eq!(layer.points[7].colour_text.as_deref(), Some("#ff00ff"));
-    let worst = compare_with_render(client, file, &refined).await;
+    assert_eq!(
+        layer
+            .wedges
+            .iter()
+            .find(|w| (w.point, w.face) == (8, 7))
+            .unwrap()
+            .opacity,
+        Some(0.2)
+    );
+    let worst = compare_with_render(client, file, &side_faded).await;
     assert!(
         worst <= 2,
         "the canvas differs from the render of the saved file by {worst} levels"
