@@ -17,8 +17,9 @@
 //! are drawn in patch order, and within a patch in the order Cairo paints (higher `v`, along
 //! the top side, later; then higher `u`), so that where patches fold, the later one shows.
 //!
-//! The mesh's own edge is anti-aliased like a layer's outline (Cairo's is not); where the
-//! shape clips the mesh, which is the usual case, the clip decides the edge.
+//! The mesh covers the union of its triangles (where patches fold beyond the mesh's outline
+//! too, as Cairo paints them) and, along its outline, the outline's exact area; the clip to
+//! the shape, which SVG always has, decides the anti-aliased edge.
 
 use std::time::Instant;
 
@@ -103,6 +104,7 @@ pub(crate) fn prepare(fill: &MeshFill, opts: &RenderOptions, xf: &ToPixels) -> L
         bounds: None,
         colours_in_unit_range: true,
         clip: None,
+        covered_by_triangles: true,
     };
     (info, Some(layer), Vec::new())
 }

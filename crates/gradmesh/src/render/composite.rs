@@ -296,7 +296,16 @@ fn draw_layer<P: OutputPixel>(
     for r in 0..rows {
         // Left of the layer's columns the accumulation is all zeros, so its prefix sums
         // may start there. Only columns `a..b` are covered at all.
-        let (a, b) = s.accumulation.resolve(r, c0, d1, &mut s.coverage);
+        let (mut a, mut b) = s.accumulation.resolve(r, c0, d1, &mut s.coverage);
+        if layer.covered_by_triangles {
+            let covered = &s.covered[r * w + d0..r * w + d1];
+            for (c, &inside) in s.coverage[d0..d1].iter_mut().zip(covered) {
+                if inside {
+                    *c = 1.0;
+                }
+            }
+            (a, b) = (d0, d1);
+        }
         let (a, b) = match &layer.clip {
             Some(clip) => {
                 let cols = (c0.min(clip.columns.0), d1);

@@ -102,6 +102,10 @@ pub(crate) struct DrawableLayer {
     pub colours_in_unit_range: bool,
     /// The outline the layer is clipped to, if any.
     pub clip: Option<Clip>,
+    /// Whether a pixel whose centre a triangle covers counts as covered whatever the
+    /// outline's coverage: the layer is the union of its triangles, also where it folds over
+    /// its outline (the classic painting of an SVG mesh, whose clip gives the edge).
+    pub covered_by_triangles: bool,
 }
 
 /// The outline a layer is clipped to, ready to draw (see `clip.rs`): a pixel's coverage is
@@ -198,6 +202,8 @@ impl DrawableLayer {
         let Some(segments) = segments.filter(|_| {
             self.clip.is_none()
                 && old.clip.is_none()
+                && !self.covered_by_triangles
+                && !old.covered_by_triangles
                 && self.space == old.space
                 && self.columns == old.columns
                 && bounds(&self.bounds) == bounds(&old.bounds)
@@ -570,6 +576,7 @@ pub(crate) fn prepare(
         bounds,
         colours_in_unit_range,
         clip: None,
+        covered_by_triangles: false,
     };
     Ok((info, Some(layer), warnings))
 }
@@ -783,6 +790,7 @@ mod tests {
             bounds: None,
             colours_in_unit_range: false,
             clip: None,
+            covered_by_triangles: false,
         }
     }
 
