@@ -544,6 +544,56 @@ mod tests {
         assert_eq!(chord_slopes(&[0.3, 0.6, 0.9], &[0.0, 1.0])[..2], [0.0, 0.0]);
     }
 
+    /// A one-patch mesh filling an even-odd path with a hole, at half opacity: nothing shows
+    /// in the hole or outside the shape, the edge at x = 10.5 covers half of its pixels, and
+    /// inside, the classic colour is bilinear in sRGB between the stop colours (the first
+    /// stop's corner top left, then clockwise).
+    #[test]
+    fn an_even_odd_shape_clips_a_translucent_mesh() {
+        use crate::render::{render_svg_scene, SvgMeshRendering, View};
+        let text = r##"<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 100 100">
+          <meshgradient id="m" gradientUnits="userSpaceOnUse"><meshrow><meshpatch>
+            <stop path="l 100,0" stop-color="#ff0000"/>
+            <stop path="l 0,100" stop-color="#00ff00"/>
+            <stop path="l -100,0" stop-color="#0000ff"/>
+            <stop path="l 0,-100" stop-color="#ffffff"/>
+          </meshpatch></meshrow></meshgradient>
+          <path d="M10.5,10 H90 V90 H10.5 Z M30,30 H70 V70 H30 Z" fill-rule="evenodd"
+                fill="url(#m)" fill-opacity="0.5"/>
+        </svg>"##;
+        let scene = crate::formats::svg::read_svg(text).unwrap();
+        let opts = RenderOptions::new(100, 100, View::new(0.0, 0.0, 100.0, 100.0));
+        for mode in [SvgMeshRendering::Classic, SvgMeshRendering::Scheme] {
+            let (image, _) = render_svg_scene(&scene, mode, &opts).unwrap();
+            assert_eq!(image.pixel(50, 50)[3], 0.0, "{mode:?}: the hole");
+            assert_eq!(image.pixel(5, 50)[3], 0.0, "{mode:?}: outside");
+            assert!((image.pixel(20, 50)[3] - 0.5).abs() < 1e-5, "{mode:?}");
+            assert!(
+                (image.pixel(10, 50)[3] - 0.25).abs() < 1e-5,
+                "{mode:?}: the edge"
+            );
+        }
+        let (image, _) = render_svg_scene(&scene, SvgMeshRendering::Classic, &opts).unwrap();
+        // Pixel (20, 50): v = 0.205 across, u = 0.505 down.
+        let (u, v) = (0.505, 0.205);
+        let [red, green, blue, white] = [
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [1.0, 1.0, 1.0],
+        ];
+        let px = image.pixel(20, 50);
+        for ch in 0..3 {
+            let top = (1.0 - v) * red[ch] + v * green[ch];
+            let bottom = (1.0 - v) * white[ch] + v * blue[ch];
+            let want = (1.0 - u) * top + u * bottom;
+            assert!(
+                (f64::from(px[ch]) - want).abs() < 2e-3,
+                "{px:?} channel {ch}: {want}"
+            );
+        }
+    }
+
     /// Hermite interpolation with slopes equal to a linear ramp's reproduces the ramp.
     #[test]
     fn hermite_basis_reproduces_a_line() {
