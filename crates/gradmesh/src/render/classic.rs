@@ -33,6 +33,7 @@ use super::triangles::{screen_triangle_px, Triangle, TriangleList, UNBOUNDED};
 use super::view::ToPixels;
 use super::{LayerInfo, LayerTimings, RenderOptions};
 use crate::colour::ColourSpace;
+use crate::error::{Error, ErrorKind};
 use crate::formats::svg::{MeshFill, MeshGrid, MeshType};
 
 /// The widest a cell may be (pixels, along each parameter): colour is bilinear in the patch's
@@ -47,14 +48,36 @@ const MAX_CELLS_PER_SIDE: usize = 1024;
 const BICUBIC_SPLIT: usize = 8;
 
 /// Prepares `fill`'s mesh for drawing with `opts` (never clipped: the caller adds the clip).
-pub(crate) fn prepare(fill: &MeshFill, opts: &RenderOptions, xf: &ToPixels) -> LayerPreparation {
+/// A mesh whose patches need more cells than [`RenderOptions::max_quads`] at the least (one
+/// per patch, or one per lattice cell of `type="bicubic"`) is refused before any is made.
+pub(crate) fn prepare(
+    fill: &MeshFill,
+    opts: &RenderOptions,
+    xf: &ToPixels,
+) -> Result<LayerPreparation, Error> {
     let start = Instant::now();
     let grid = &fill.mesh;
+    let k = match grid.kind {
+        MeshType::Bicubic => BICUBIC_SPLIT,
+        MeshType::Bilinear | MeshType::Coons => 1,
+    };
+    let fewest = (grid.rows * grid.columns) as u64 * (k * k) as u64;
+    if fewest > opts.max_quads as u64 {
+        return Err(ErrorKind::LimitExceeded {
+            what: format!(
+                "cells of the patches of mesh gradient {:?}",
+                fill.gradient_id
+            ),
+            found: fewest,
+            limit: opts.max_quads as u64,
+        }
+        .into());
+    }
     let lattices = match grid.kind {
         MeshType::Bicubic => bicubic_lattices(grid),
         MeshType::Bilinear | MeshType::Coons => corner_lattices(grid),
     };
-    let counts = CellCounts::new(grid, lattices[0].k, opts, xf);
+    let counts = CellCounts::new(grid, k, opts, xf);
     let opacity = fill.fill_opacity * fill.group_opacity;
     let size = (opts.width as i64, opts.height as i64);
     let patches: Vec<Patch> = (0..grid.rows * grid.columns)
@@ -91,7 +114,7 @@ pub(crate) fn prepare(fill: &MeshFill, opts: &RenderOptions, xf: &ToPixels) -> L
         reused_faces: 0,
     };
     if lines.is_empty() || columns.0 >= columns.1 {
-        return (info, None, Vec::new());
+        return Ok((info, None, Vec::new()));
     }
     let layer = DrawableLayer {
         space: ColourSpace::Srgb,
@@ -106,7 +129,7 @@ pub(crate) fn prepare(fill: &MeshFill, opts: &RenderOptions, xf: &ToPixels) -> L
         clip: None,
         covered_by_triangles: true,
     };
-    (info, Some(layer), Vec::new())
+    Ok((info, Some(layer), Vec::new()))
 }
 
 /// Cells per patch: `across[c]` along the rows for every patch of grid column `c`, `down[r]`
@@ -592,6 +615,33 @@ mod tests {
                 "{px:?} channel {ch}: {want}"
             );
         }
+    }
+
+    /// A mesh needing more cells than `max_quads` at the least is refused; within it, the
+    /// cells grow until they fit.
+    #[test]
+    fn cells_stay_within_max_quads() {
+        use crate::render::{render_svg_scene, SvgMeshRendering, View};
+        let text = r##"<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 100 100">
+          <meshgradient id="m" gradientUnits="userSpaceOnUse" type="bicubic"><meshrow><meshpatch>
+            <stop path="l 100,0" stop-color="#ff0000"/>
+            <stop path="l 0,100" stop-color="#00ff00"/>
+            <stop path="l -100,0" stop-color="#0000ff"/>
+            <stop path="l 0,-100" stop-color="#ffffff"/>
+          </meshpatch></meshrow></meshgradient>
+          <rect width="100" height="100" fill="url(#m)"/>
+        </svg>"##;
+        let scene = crate::formats::svg::read_svg(text).unwrap();
+        let mut opts = RenderOptions::new(400, 400, View::new(0.0, 0.0, 100.0, 100.0));
+        opts.max_quads = 63;
+        let error = render_svg_scene(&scene, SvgMeshRendering::Classic, &opts).unwrap_err();
+        assert!(
+            error.to_string().contains("above the limit of 63"),
+            "{error}"
+        );
+        opts.max_quads = 1000;
+        let (_, info) = render_svg_scene(&scene, SvgMeshRendering::Classic, &opts).unwrap();
+        assert!(info.layers[0].quads <= 1000 && info.layers[0].capped);
     }
 
     /// Hermite interpolation with slopes equal to a linear ramp's reproduces the ramp.

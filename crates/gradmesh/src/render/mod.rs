@@ -341,7 +341,9 @@ pub fn render_picture_into<P: OutputPixel>(
         .map(|(i, picture)| {
             let (info, drawable, warnings) = match picture.source {
                 LayerSource::Scheme(mesh) => layer::prepare(mesh, i, opts, &xf, &shapes, None)?,
-                LayerSource::Classic(fill) => classic::prepare(fill, opts, &xf),
+                LayerSource::Classic(fill) => {
+                    classic::prepare(fill, opts, &xf).map_err(|e| e.in_layer(i))?
+                }
             };
             let drawable = drawable.map(|mut d| {
                 d.clip = picture
