@@ -166,6 +166,25 @@ impl From<PdfColourArg> for gradmesh::export::PdfColour {
     }
 }
 
+/// `--svg-mesh`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SvgMeshArg {
+    /// As Inkscape and the SVG 2 draft paint them: Coons patches, colour bilinear in sRGB
+    /// (smoothed across patches for type="bicubic").
+    Classic,
+    /// Converted into the scheme (as `convert` writes them), drawn as limit surfaces.
+    Scheme,
+}
+
+impl From<SvgMeshArg> for gradmesh::render::SvgMeshRendering {
+    fn from(mode: SvgMeshArg) -> Self {
+        match mode {
+            SvgMeshArg::Classic => gradmesh::render::SvgMeshRendering::Classic,
+            SvgMeshArg::Scheme => gradmesh::render::SvgMeshRendering::Scheme,
+        }
+    }
+}
+
 /// `--gamut`.
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum GamutArg {
@@ -297,6 +316,11 @@ pub struct RenderArgs {
     /// Gamut mapping of out-of-gamut colours.
     #[arg(long, default_value = "chroma")]
     pub gamut: GamutArg,
+    /// PNG: how the mesh gradients of SVG inputs are drawn, each clipped to its shape:
+    /// `classic` as Inkscape paints them, `scheme` converted into the scheme (the layers
+    /// `convert` writes). PDF and SVG output always take the scheme.
+    #[arg(long, value_name = "MODE", default_value = "classic")]
+    pub svg_mesh: SvgMeshArg,
     /// Slow and simple reference rendering (for checking the fast path).
     #[arg(long)]
     pub reference: bool,

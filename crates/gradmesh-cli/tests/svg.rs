@@ -126,3 +126,99 @@ fn svg_renders_its_own_viewport_by_default() {
         );
     }
 }
+
+/// The 13 test files: the W3C tests and the Inkscape samples.
+fn all_test_files() -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = (1..=5)
+        .map(|k| sample(&format!("../wpt/meshgradient-basic-00{k}.svg")))
+        .collect();
+    files.push(sample("../wpt/meshgradient-bicubic-001.svg"));
+    files.push(sample("../wpt/meshgradient-complex-001.svg"));
+    files.extend((1..=6).map(|k| sample(&format!("sample{k}.svg"))));
+    files
+}
+
+/// Every test file goes SVG -> `convert` -> JSON -> `render`, and renders straight from the
+/// SVG with `--svg-mesh classic` and `scheme`: the three pictures have the file's size; the
+/// classic and the scheme render, both clipped to the shapes, cover the same pixels (to the
+/// outlines' anti-aliasing), except in the W3C file whose patches fold beyond the mesh's
+/// outline (the classic painting covers every patch, the scheme its outline's inside); and
+/// the JSON's layers, which are not clipped, cover every pixel the clipped scheme render
+/// covers.
+#[test]
+fn every_test_file_round_trips_through_json_and_renders_both_ways() {
+    let dir = tempfile::tempdir().unwrap();
+    for svg in all_test_files() {
+        let name = svg.file_stem().unwrap().to_str().unwrap().to_string();
+        let json = dir.path().join(format!("{name}.json"));
+        let run = |args: &[&str]| {
+            let out = gradmesh(args);
+            assert!(
+                out.status.success(),
+                "{name}: {args:?}: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+        };
+        let (svg_arg, json_arg) = (svg.to_str().unwrap(), json.to_str().unwrap());
+        run(&["convert", svg_arg, "-o", json_arg]);
+        let png = |what: &str| dir.path().join(format!("{name}-{what}.png"));
+        let (from_json, classic, scheme) = (png("json"), png("classic"), png("scheme"));
+        let (w, h, _) = decode_png(
+            &sample("sample3.svg")
+                .parent()
+                .unwrap()
+                .join(format!("../inkscape-1.2.2-renders/{name}.png")),
+        );
+        // The JSON keeps the root's user units: drawn with the SVG's view box.
+        let text = std::fs::read_to_string(&svg).unwrap();
+        let view = gradmesh::formats::svg::read_svg(&text)
+            .unwrap()
+            .view_rect()
+            .unwrap();
+        let numbers = [w, h]
+            .map(|v| v.to_string())
+            .into_iter()
+            .chain([view.x0, view.y0, view.x1, view.y1].map(|v| v.to_string()))
+            .collect::<Vec<_>>();
+        let mut args = vec!["render", json_arg, "-o", from_json.to_str().unwrap()];
+        args.extend(["--width", &numbers[0], "--height", &numbers[1], "--view"]);
+        args.extend(numbers[2..].iter().map(String::as_str));
+        run(&args);
+        for (mode, out) in [("classic", &classic), ("scheme", &scheme)] {
+            run(&[
+                "render",
+                svg_arg,
+                "-o",
+                out.to_str().unwrap(),
+                "--svg-mesh",
+                mode,
+            ]);
+        }
+        let [json_px, classic_px, scheme_px] = [&from_json, &classic, &scheme].map(|p| {
+            let (pw, ph, data) = decode_png(p);
+            assert_eq!((pw, ph), (w, h), "{name}: {}", p.display());
+            data
+        });
+        let alpha = |data: &[u8], i: usize| data[4 * i + 3];
+        let pixels = (w * h) as usize;
+        let covered = (0..pixels).filter(|&i| alpha(&classic_px, i) > 127).count();
+        assert!(
+            covered > pixels / 50,
+            "{name}: classic covers {covered} pixels"
+        );
+        let disagree = (0..pixels)
+            .filter(|&i| (alpha(&classic_px, i) > 127) != (alpha(&scheme_px, i) > 127))
+            .count();
+        assert!(
+            disagree * 50 < covered || name == "meshgradient-complex-001",
+            "{name}: classic and scheme coverage differ on {disagree} of {covered} pixels"
+        );
+        let uncovered = (0..pixels)
+            .filter(|&i| alpha(&scheme_px, i) == 255 && alpha(&json_px, i) < 255)
+            .count();
+        assert_eq!(
+            uncovered, 0,
+            "{name}: the JSON leaves pixels of the SVG uncovered"
+        );
+    }
+}

@@ -42,18 +42,23 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
 /// Reads a document within `limits`, with errors located in the file. An SVG file's warnings
 /// (what was left out) are printed.
 fn read(path: &Path, limits: &gradmesh::Limits) -> Result<Document, Error> {
-    Ok(read_with_viewport(path, limits)?.0)
+    Ok(read_with_viewport(path, limits)?.document)
 }
 
 /// The part of the plane a file shows and the picture's size in pixels, where the file says
 /// (an SVG file's view box and size).
 type Viewport = (gradmesh::render::View, (f64, f64));
 
-/// [`read`], with the file's [`Viewport`] when it has one.
-fn read_with_viewport(
-    path: &Path,
-    limits: &gradmesh::Limits,
-) -> Result<(Document, Option<Viewport>), Error> {
+/// A file read: its document, and for an SVG file its [`Viewport`] and the mesh-gradient fills
+/// its layers were converted from (one per layer).
+struct Input {
+    document: Document,
+    viewport: Option<Viewport>,
+    fills: Option<Vec<gradmesh::formats::svg::MeshFill>>,
+}
+
+/// [`read`], with the file's [`Viewport`] and fills when it has them.
+fn read_with_viewport(path: &Path, limits: &gradmesh::Limits) -> Result<Input, Error> {
     use gradmesh::formats::{svg, Format};
     if Format::from_path(path) == Some(Format::Svg) {
         let read = svg::read_path_with_limits(path, limits)?;
@@ -62,12 +67,17 @@ fn read_with_viewport(
             .view
             .map(gradmesh::render::View::from_rect)
             .zip(read.pixel_size);
-        return Ok((read.document, viewport));
+        return Ok(Input {
+            document: read.document,
+            viewport,
+            fills: Some(read.fills),
+        });
     }
-    Ok((
-        gradmesh::formats::read_path_with_limits(path, limits)?,
-        None,
-    ))
+    Ok(Input {
+        document: gradmesh::formats::read_path_with_limits(path, limits)?,
+        viewport: None,
+        fills: None,
+    })
 }
 
 /// Refuses to write over an input unless `force` is given.

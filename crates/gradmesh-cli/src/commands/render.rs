@@ -4,8 +4,11 @@ use std::time::Instant;
 
 use gradmesh::export::{self, ExportOptions};
 use gradmesh::formats;
+use gradmesh::formats::svg::MeshFill;
 use gradmesh::parse_css_colour;
-use gradmesh::render::{self, PngDepth, RenderOptions, View};
+use gradmesh::render::{
+    self, LayerSource, PictureLayer, PngDepth, RenderOptions, SvgMeshRendering, View,
+};
 use gradmesh::{ColourSpace, Document, Error, ErrorKind};
 
 use crate::args::RenderArgs;
@@ -101,13 +104,19 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     let mut origins = Vec::new();
     let limits = args.limits.limits();
     let mut viewport = None;
+    // For each layer: the SVG fill it was converted from, if any.
+    let mut fills = Vec::new();
     for (k, path) in args.inputs.iter().enumerate() {
-        let (read, file_viewport) = super::read_with_viewport(path, &limits)?;
+        let read = super::read_with_viewport(path, &limits)?;
         if k == 0 {
-            viewport = file_viewport;
+            viewport = read.viewport;
         }
-        let layers = read.layers;
+        let layers = read.document.layers;
         origins.extend((0..layers.len()).map(|i| (path.as_path(), i)));
+        match read.fills {
+            Some(f) => fills.extend(f.into_iter().map(Some)),
+            None => fills.extend(layers.iter().map(|_| None)),
+        }
         doc.layers.extend(layers);
     }
     args.variant.apply(&mut doc);
@@ -131,17 +140,20 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     let channels = 4 * opts.width as usize * opts.height as usize;
     // Straight into the output's channel type, unless outlines are drawn on top (on the `f32`
     // image): an `f32` image is four times the memory of 8-bit output.
+    let picture = picture_layers(&doc, &fills, args.svg_mesh.into());
+    let picture = picture.as_deref();
     let (pixels, info) = if args.boundary {
-        let (mut image, info) = render::render_image(&doc, &opts).map_err(locate)?;
+        let mut image = render::Image::new(opts.width, opts.height);
+        let info = draw(&doc, picture, &opts, &mut image.data).map_err(locate)?;
         render::draw_outlines(&doc, &opts, &mut image).map_err(locate)?;
         (Pixels::Float(image), info)
     } else if args.bits == 16 {
         let mut data = vec![0u16; channels];
-        let info = render::render_document_into(&doc, &opts, &mut data).map_err(locate)?;
+        let info = draw(&doc, picture, &opts, &mut data).map_err(locate)?;
         (Pixels::Sixteen(data), info)
     } else {
         let mut data = vec![0u8; channels];
-        let info = render::render_document_into(&doc, &opts, &mut data).map_err(locate)?;
+        let info = draw(&doc, picture, &opts, &mut data).map_err(locate)?;
         (Pixels::Eight(data), info)
     };
     let rendered = start.elapsed();
@@ -200,6 +212,47 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         }
     }
     Ok(())
+}
+
+/// The layers of the picture when an input is an SVG file (`fills[i]` is the fill layer `i` of
+/// `doc` was converted from): its fills clipped to their shapes, drawn as `mode` says, the
+/// other inputs' layers as they are. `None` when no input is an SVG file.
+fn picture_layers<'a>(
+    doc: &'a Document,
+    fills: &'a [Option<MeshFill>],
+    mode: SvgMeshRendering,
+) -> Option<Vec<PictureLayer<'a>>> {
+    fills.iter().any(Option::is_some).then(|| {
+        doc.layers
+            .iter()
+            .zip(fills)
+            .map(|(mesh, fill)| match fill {
+                Some(fill) => render::svg_picture_layers(
+                    std::slice::from_ref(fill),
+                    std::slice::from_ref(mesh),
+                    mode,
+                )
+                .remove(0),
+                None => PictureLayer {
+                    source: LayerSource::Scheme(mesh),
+                    clip: None,
+                },
+            })
+            .collect()
+    })
+}
+
+/// Draws `picture` when there is one, else `doc`, into `out`.
+fn draw<P: render::OutputPixel>(
+    doc: &Document,
+    picture: Option<&[PictureLayer<'_>]>,
+    opts: &RenderOptions,
+    out: &mut [P],
+) -> Result<render::RenderInfo, Error> {
+    match picture {
+        Some(layers) => render::render_picture_into(layers, opts, out),
+        None => render::render_document_into(doc, opts, out),
+    }
 }
 
 /// Writes the document as a PDF (`pdf`) or an SVG, with the page and view of `render`.

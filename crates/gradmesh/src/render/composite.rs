@@ -11,7 +11,7 @@ use super::coverage;
 use super::each4;
 use super::gamut::GamutMapping;
 use super::gamut::{self, BlendSpace, RUN};
-use super::layer::{DrawableLayer, BAND};
+use super::layer::{Clip, DrawableLayer, BAND};
 use super::options::RenderOptions;
 use super::output;
 use super::output::OutputPixel;
@@ -26,6 +26,9 @@ pub(super) struct Scratch {
     opaque: Vec<bool>,
     accumulation: coverage::Accumulator,
     coverage: Vec<f32>,
+    /// The same for a layer's clip outline.
+    clip_accumulation: coverage::Accumulator,
+    clip_coverage: Vec<f32>,
     /// The pixels of a run that a layer shows, before and after conversion to the blend space.
     run: Box<Run>,
     /// Premultiplied colour in the blend space. Single precision: compositing a few layers
@@ -68,6 +71,8 @@ impl Scratch {
             opaque: vec![false; w * BAND],
             accumulation: coverage::Accumulator::new(w, BAND),
             coverage: vec![0.0; w],
+            clip_accumulation: coverage::Accumulator::new(w, BAND),
+            clip_coverage: vec![0.0; w],
             colour: vec![[0.0; 4]; w * BAND],
             run: Box::new(Run {
                 colour: [[0.0; RUN]; 3],
@@ -283,12 +288,45 @@ fn draw_layer<P: OutputPixel>(
         }
         s.accumulation.add(y0 as i64, rows, line);
     }
+    if let Some(clip) = &layer.clip {
+        accumulate_clip(clip, band, area, d1, &mut s.clip_accumulation);
+    }
     let colour = &mut s.colour[..w * rows];
     let mut opaque = 0;
     for r in 0..rows {
         // Left of the layer's columns the accumulation is all zeros, so its prefix sums
         // may start there. Only columns `a..b` are covered at all.
-        let (a, b) = s.accumulation.resolve(r, c0, d1, &mut s.coverage);
+        let (mut a, mut b) = s.accumulation.resolve(r, c0, d1, &mut s.coverage);
+        if layer.covered_by_triangles {
+            let covered = &s.covered[r * w + d0..r * w + d1];
+            for (c, &inside) in s.coverage[d0..d1].iter_mut().zip(covered) {
+                if inside {
+                    *c = 1.0;
+                }
+            }
+            (a, b) = (d0, d1);
+        }
+        let (a, b) = match &layer.clip {
+            Some(clip) => {
+                let cols = (c0.min(clip.columns.0), d1);
+                let (ca, cb) = clip_row(
+                    clip,
+                    r,
+                    cols,
+                    &mut s.clip_accumulation,
+                    &mut s.clip_coverage,
+                );
+                let (a, b) = (a.max(ca), b.min(cb));
+                for (c, &k) in s.coverage[a.min(b)..b]
+                    .iter_mut()
+                    .zip(&s.clip_coverage[a.min(b)..b])
+                {
+                    *c = c.min(k);
+                }
+                (a, b.max(a))
+            }
+            None => (a, b),
+        };
         // Bounds the loops below can see, so that they index without checks.
         let coverage = &s.coverage[..d1];
         let (a, b) = (a.max(d0), b.min(d1));
@@ -310,6 +348,42 @@ fn draw_layer<P: OutputPixel>(
         };
     }
     Some((opaque, farthest.get()))
+}
+
+/// Adds the lines of `clip` that cross band `band` (those that can change columns before `d1`)
+/// to `acc`.
+#[inline(always)]
+fn accumulate_clip(
+    clip: &Clip,
+    band: usize,
+    area: BandArea,
+    d1: usize,
+    acc: &mut coverage::Accumulator,
+) {
+    for &li in clip.line_bins.get(band) {
+        let line = &clip.lines[li as usize];
+        if !area.whole_rows && line.p0[0].min(line.p1[0]) >= d1 as f64 {
+            continue;
+        }
+        acc.add(area.y0 as i64, area.rows, line);
+    }
+}
+
+/// Resolves row `r` of a clip's accumulation over columns `cols` into `out` with the clip's
+/// fill rule (clearing the row); returns the columns outside which the clip covers nothing.
+#[inline(always)]
+fn clip_row(
+    clip: &Clip,
+    r: usize,
+    (c0, c1): (usize, usize),
+    acc: &mut coverage::Accumulator,
+    out: &mut [f32],
+) -> (usize, usize) {
+    if clip.even_odd {
+        acc.resolve_with::<true>(r, c0, c1, out)
+    } else {
+        acc.resolve_with::<false>(r, c0, c1, out)
+    }
 }
 
 /// Fills the attributes of the pixels in columns `cols` that the layer's triangles cover, and

@@ -98,7 +98,25 @@ impl Accumulator {
     /// row. Returns the columns `[a, b)` outside which that coverage is zero.
     ///
     /// The same sums as a prefix sum over every cell from `c0`: the cells skipped are zero.
+    /// Coverage follows the non-zero rule.
     pub fn resolve(&mut self, r: usize, c0: usize, c1: usize, out: &mut [f32]) -> (usize, usize) {
+        self.resolve_with::<false>(r, c0, c1, out)
+    }
+
+    /// [`Accumulator::resolve`] with the even-odd rule when `EVEN_ODD`, else the non-zero rule.
+    #[inline(always)]
+    pub fn resolve_with<const EVEN_ODD: bool>(
+        &mut self,
+        r: usize,
+        c0: usize,
+        c1: usize,
+        out: &mut [f32],
+    ) -> (usize, usize) {
+        let coverage_of = if EVEN_ODD {
+            coverage_even_odd
+        } else {
+            coverage_of
+        };
         let stride = self.width + 2;
         let row = &mut self.cells[r * stride..(r + 1) * stride];
         let runs = &mut self.touched[r];
@@ -204,10 +222,23 @@ fn add_span(row: &mut [f64], x0: f64, x1: f64, d: f64) -> [usize; 2] {
     [c0, last + 1]
 }
 
-/// The coverage in `0..=1` of a winding-weighted area.
+/// The coverage in `0..=1` of a winding-weighted area (non-zero rule).
 #[inline]
 fn coverage_of(sum: f64) -> f32 {
-    let c = sum.abs().min(1.0);
+    clean(sum.abs().min(1.0))
+}
+
+/// The coverage in `0..=1` of a winding-weighted area under the even-odd rule: winding 2
+/// counts as outside, so the area folds back every other unit.
+#[inline]
+fn coverage_even_odd(sum: f64) -> f32 {
+    let v = sum.abs() % 2.0;
+    clean(if v > 1.0 { 2.0 - v } else { v })
+}
+
+/// A coverage in `0..=1`, with round-off next to 0 and 1 removed.
+#[inline]
+fn clean(c: f64) -> f32 {
     // Round-off of cancelled contributions is not coverage.
     if c < 1e-9 {
         0.0
@@ -337,6 +368,32 @@ mod tests {
         let mut rev = pts;
         rev.reverse();
         assert_eq!(render(&polygon(&rev), w, h), cov);
+    }
+
+    /// Under the even-odd rule a loop inside another loop of the same orientation is a hole,
+    /// with exact coverage on its edges; under the non-zero rule it is filled.
+    #[test]
+    fn even_odd_makes_holes_of_nested_loops() {
+        let outer = [[0.5, 0.5], [9.5, 0.5], [9.5, 9.5], [0.5, 9.5]];
+        let inner = [[3.0, 3.5], [7.0, 3.5], [7.0, 7.0], [3.0, 7.0]];
+        let mut lines = polygon(&outer);
+        lines.extend(polygon(&inner));
+        let (w, h) = (10, 10);
+        let mut acc = Accumulator::new(w, h);
+        for l in &lines {
+            acc.add(0, h, l);
+        }
+        let mut even_odd = vec![0.0; w * h];
+        for j in 0..h {
+            acc.resolve_with::<true>(j, 0, w, &mut even_odd[j * w..(j + 1) * w]);
+        }
+        let non_zero = render(&lines, w, h);
+        assert_eq!(non_zero[5 * w + 5], 1.0);
+        assert_eq!(even_odd[5 * w + 5], 0.0);
+        assert_eq!(even_odd[2 * w + 2], 1.0);
+        // Row 3 is half inside the hole (from y 3.5): coverage one half.
+        assert_eq!(even_odd[3 * w + 5], 0.5);
+        assert_eq!(even_odd[0], 0.25);
     }
 
     #[test]

@@ -7,6 +7,7 @@ use rayon::prelude::*;
 
 use crate::colour::ColourSpace;
 use crate::error::{Error, Warning};
+use crate::formats::svg::FillRule;
 use crate::limit_surface;
 use crate::mesh::GradientMesh;
 use crate::refine::{RefinedData, Refinement};
@@ -15,6 +16,7 @@ use crate::topology::Topology;
 use crate::validate::{attributes, BaseMesh, VertexData, COLOUR, X, Y};
 
 use super::adaptive;
+use super::clip::clip_lines;
 use super::coverage::Line;
 use super::measure::{measure, Measure, Thresholds, MIN_QUAD_PX};
 use super::nearest::{NearestSegments, Segment};
@@ -98,6 +100,39 @@ pub(crate) struct DrawableLayer {
     /// holds every colour it shows, up to rounding) have all their channels in `0..=1`: in an
     /// sRGB layer, hardly any pixel then needs gamut mapping.
     pub colours_in_unit_range: bool,
+    /// The outline the layer is clipped to, if any.
+    pub clip: Option<Clip>,
+    /// Whether a pixel whose centre a triangle covers counts as covered whatever the
+    /// outline's coverage: the layer is the union of its triangles, also where it folds over
+    /// its outline (the classic painting of an SVG mesh, whose clip gives the edge).
+    pub covered_by_triangles: bool,
+}
+
+/// The outline a layer is clipped to, ready to draw (see `clip.rs`): a pixel's coverage is
+/// the smaller of the layer's and the clip's.
+#[derive(Clone, Debug)]
+pub(crate) struct Clip {
+    /// Closed loops of line segments, in pixels.
+    pub lines: Vec<Line>,
+    pub line_bins: Bins,
+    /// Columns `[start, end)` where the clip's coverage can be non-zero.
+    pub columns: (usize, usize),
+    /// Whether the even-odd rule decides the inside (else the non-zero rule).
+    pub even_odd: bool,
+}
+
+impl Clip {
+    /// `path` (in the plane) in the pixels of `opts`, with its fill rule.
+    pub fn new(path: &kurbo::BezPath, rule: FillRule, xf: &ToPixels, opts: &RenderOptions) -> Clip {
+        let bands = (opts.height as usize).div_ceil(BAND);
+        let (lines, line_bins, columns) = visible_outline(clip_lines(path, xf), opts, bands);
+        Clip {
+            lines,
+            line_bins,
+            columns,
+            even_odd: rule == FillRule::EvenOdd,
+        }
+    }
 }
 
 /// Columns `[start, end)` of a band that may draw differently: empty when `start >= end`.
@@ -152,7 +187,8 @@ impl DrawableLayer {
     ///   pixels there took their colour from when last drawn);
     ///
     /// and every column of every band when something the whole layer's drawing reads changed
-    /// (its colour space, columns or colour bounds, or the number of boundary segments).
+    /// (its colour space, columns or colour bounds, or the number of boundary segments), or
+    /// when either is clipped.
     pub fn mark_changed_columns(
         &self,
         old: &DrawableLayer,
@@ -164,7 +200,11 @@ impl DrawableLayer {
         let bounds = |b: &Option<Bounds>| b.map(|b| b.map(|r| r.map(f32::to_bits)));
         let segments = self.nearest.changed_boxes(&old.nearest);
         let Some(segments) = segments.filter(|_| {
-            self.space == old.space
+            self.clip.is_none()
+                && old.clip.is_none()
+                && !self.covered_by_triangles
+                && !old.covered_by_triangles
+                && self.space == old.space
                 && self.columns == old.columns
                 && bounds(&self.bounds) == bounds(&old.bounds)
                 && self.colours_in_unit_range == old.colours_in_unit_range
@@ -535,6 +575,8 @@ pub(crate) fn prepare(
         columns,
         bounds,
         colours_in_unit_range,
+        clip: None,
+        covered_by_triangles: false,
     };
     Ok((info, Some(layer), warnings))
 }
@@ -667,7 +709,7 @@ fn tessellate_layer(
 }
 
 /// The triangles of each band of rows, of an image `h` rows high.
-fn bin_triangles(triangles: &TriangleList, bands: usize, h: i64) -> Bins {
+pub(crate) fn bin_triangles(triangles: &TriangleList, bands: usize, h: i64) -> Bins {
     let ranges: Vec<(u32, usize, usize)> = triangles
         .iter()
         .enumerate()
@@ -681,7 +723,7 @@ fn bin_triangles(triangles: &TriangleList, bands: usize, h: i64) -> Bins {
 
 /// The lines of the outline that can change a pixel of the image, binned by band, and the
 /// columns where coverage can be non-zero.
-fn visible_outline(
+pub(crate) fn visible_outline(
     all_lines: Vec<Line>,
     opts: &RenderOptions,
     bands: usize,
@@ -747,6 +789,8 @@ mod tests {
             columns: (0, 20),
             bounds: None,
             colours_in_unit_range: false,
+            clip: None,
+            covered_by_triangles: false,
         }
     }
 

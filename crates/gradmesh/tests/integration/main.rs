@@ -31,5 +31,6 @@ mod reference_images;
 mod reference_outputs;
 mod render;
 mod svg;
+mod svg_inkscape;
 mod threads;
 mod validation;

@@ -61,6 +61,9 @@ pub struct SvgDocument {
     pub view: Option<kurbo::Rect>,
     /// The picture's size in CSS pixels ([`SvgScene::pixel_size`]).
     pub pixel_size: Option<(f64, f64)>,
+    /// The fills the layers were converted from, `fills[i]` for layer `i`: their clips, and
+    /// what the classic rendering draws.
+    pub fills: Vec<MeshFill>,
 }
 
 /// Reads an SVG document and converts every mesh-gradient fill into a layer with colours in
@@ -88,6 +91,7 @@ pub fn read_document_with_limits(
         warnings,
         view: scene.view_rect(),
         pixel_size: scene.pixel_size(),
+        fills: scene.fills,
     })
 }
 
