@@ -2,6 +2,7 @@
 //!
 //! Flags are parsed in `args`; each subcommand in `commands` turns them into library calls.
 
+mod allocator;
 mod args;
 mod commands;
 
@@ -10,6 +11,7 @@ use std::process::ExitCode;
 use clap::Parser;
 
 fn main() -> ExitCode {
+    allocator::tune();
     let cli = args::Cli::parse();
     match commands::run(cli) {
         Ok(()) => ExitCode::SUCCESS,

@@ -443,6 +443,43 @@ fn edits_are_listed_and_applied_by_refine() {
     assert!(String::from_utf8(out.stdout).unwrap().contains("no edits"));
 }
 
+/// `--png-compression best` writes a smaller file of the same pixels.
+#[test]
+fn png_compression_keeps_the_pixels() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = realdata().join("Glasses.off");
+    let decode = |path: &Path| {
+        let file = std::fs::File::open(path).unwrap();
+        let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+            .read_info()
+            .unwrap();
+        let mut data = vec![0; reader.output_buffer_size().unwrap()];
+        reader.next_frame(&mut data).unwrap();
+        data
+    };
+    let mut files = Vec::new();
+    for level in ["fast", "best"] {
+        let out = dir.path().join(format!("{level}.png"));
+        let args = ["render", s(&input), "-o", s(&out), "--width", "300"];
+        let o = gradmesh(&[&args[..], &["--png-compression", level]].concat());
+        assert!(o.status.success(), "{}", stderr(&o));
+        files.push(out);
+    }
+    assert_eq!(decode(&files[0]), decode(&files[1]));
+    let size = |p: &Path| std::fs::metadata(p).unwrap().len();
+    assert!(size(&files[1]) < size(&files[0]));
+    let o = gradmesh(&[
+        "render",
+        s(&input),
+        "-o",
+        "x.png",
+        "--png-compression",
+        "max",
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("fast"), "{}", stderr(&o));
+}
+
 /// `render` draws straight into 8- or 16-bit pixels (no `f32` image) unless outlines go on
 /// top: every way gives the bytes the library's image path encodes.
 #[test]

@@ -2,12 +2,13 @@
 //! side, and the floor: filling the same RGBA `f32` buffer with one colour. Then the authors'
 //! six-layer Tucan at 1024 pixels wide into an 8-bit buffer, from scratch and as an editor
 //! re-renders it after one layer changed (`RenderCache`); Glasses at 1024 and both at 4096
-//! pixels wide, and the three Paprika layers at 1024 (`artwork`). Last, time against mesh
-//! size: jittered grids of 10 to 10,000 faces at 1024x1024 (`mesh_size_1024`).
+//! pixels wide, and the three Paprika layers at 1024 (`artwork`). Time against mesh size:
+//! jittered grids of 10 to 10,000 faces at 1024x1024 (`mesh_size_1024`). Last, PNG encoding
+//! of a rendered megapixel (`png_megapixel`).
 //!
 //! Run: `cargo bench -p gradmesh --bench render` (add a name to run one example, e.g.
 //! `-- rectangle`, `-- tucan_1024` for the editing figures, `-- artwork` for the others,
-//! `-- mesh_size` for the grids).
+//! `-- mesh_size` for the grids, `-- png` for encoding).
 
 #![allow(missing_docs)] // criterion_group! generates undocumented items.
 
@@ -17,8 +18,8 @@ use std::time::Duration;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use gradmesh::formats;
 use gradmesh::render::{
-    render_document, render_document_into, render_document_into_cached, GamutMapping, RenderCache,
-    RenderOptions,
+    render_document, render_document_into, render_document_into_cached, write_png_rgba8_with,
+    GamutMapping, PngCompression, RenderCache, RenderOptions, View,
 };
 use gradmesh::Document;
 
@@ -130,6 +131,16 @@ fn bench_editing(c: &mut Criterion) {
     g.bench_function("from_scratch", |b| {
         b.iter(|| render_document_into(black_box(&doc), &opts, &mut buffer).unwrap())
     });
+    // The render `gradmesh render Tucan_Tucan_Layer{5,4,3,2,1,0}.off --width 1024` makes: the
+    // command line's view has no margin (its faces along the fold need more cells), and
+    // 1024x559 pixels. The whole process is measured against this.
+    {
+        let opts = command_line_options(&doc, 1024);
+        let mut buffer = vec![0u8; 4 * (opts.width * opts.height) as usize];
+        g.bench_function("command_line_view", |b| {
+            b.iter(|| render_document_into(black_box(&doc), &opts, &mut buffer).unwrap())
+        });
+    }
     // The drawing stage alone (every pixel, from prepared layers); preparing is the rest of
     // `from_scratch`.
     {
@@ -179,11 +190,50 @@ fn bench_mesh_size(c: &mut Criterion) {
     g.finish();
 }
 
+/// The options `gradmesh render --width WIDTH` takes for `doc`: the document's bounds with
+/// no margin, the height from their aspect ratio.
+fn command_line_options(doc: &Document, width: u32) -> RenderOptions {
+    let view = View::fit(doc, 0.0);
+    let height = (width as f64 * view.height() / view.width())
+        .round()
+        .max(1.0) as u32;
+    RenderOptions::new(width, height, view)
+}
+
+/// PNG encoding of about a megapixel: Tucan rendered 1372 pixels wide (1372x749, dithered),
+/// as the command line encodes it (`fast`, the default) and with `--png-compression best`.
+fn bench_png(c: &mut Criterion) {
+    let Some(doc) = tucan() else {
+        eprintln!("shared/realdata not found: skipping the PNG benchmarks");
+        return;
+    };
+    let opts = command_line_options(&doc, 1372);
+    let (w, h) = (opts.width, opts.height);
+    let mut pixels = vec![0u8; 4 * (w * h) as usize];
+    render_document_into(&doc, &opts, &mut pixels).unwrap();
+    let mut g = c.benchmark_group("png_megapixel");
+    g.sample_size(10).measurement_time(Duration::from_secs(5));
+    let mut out = Vec::new();
+    for (name, compression) in [
+        ("fast", PngCompression::Fast),
+        ("best", PngCompression::Best),
+    ] {
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                out.clear();
+                write_png_rgba8_with(&mut out, w, h, black_box(&pixels), compression).unwrap()
+            })
+        });
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
     bench,
     bench_editing,
     bench_artwork,
-    bench_mesh_size
+    bench_mesh_size,
+    bench_png
 );
 criterion_main!(benches);

@@ -98,6 +98,9 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     let inputs: Vec<&std::path::Path> = args.inputs.iter().map(|p| p.as_path()).collect();
     super::check_not_input(&args.output, &inputs, args.force)?;
 
+    // The thread pool starts while the files are read, rather than at the first parallel
+    // step of the render.
+    rayon::spawn(|| ());
     let start = Instant::now();
     let mut doc = Document::default();
     // For each layer of the document: the file it came from and its index there.
@@ -177,7 +180,9 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
                 render::write_png(out, image, depth)
             }
             Pixels::Sixteen(data) => render::write_png_rgba16(out, w, h, data),
-            Pixels::Eight(data) => render::write_png_rgba8(out, w, h, data),
+            Pixels::Eight(data) => {
+                render::write_png_rgba8_with(out, w, h, data, args.png_compression.into())
+            }
         }
         .map_err(std::io::Error::other)
     })?;

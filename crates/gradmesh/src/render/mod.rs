@@ -106,6 +106,7 @@ mod options;
 pub(crate) mod outline;
 mod output;
 mod overlay;
+mod png_deflate;
 mod quadratic;
 mod stitch;
 mod triangles;
@@ -134,7 +135,7 @@ pub use options::{
 };
 pub use output::{
     encode_png, encode_png_rgba16, encode_png_rgba8, write_png, write_png_rgba16, write_png_rgba8,
-    Image, OutputPixel, PngDepth,
+    write_png_rgba8_with, Image, OutputPixel, PngCompression, PngDepth,
 };
 pub use overlay::draw_outlines;
 pub use view::{document_bounds, View};
