@@ -12,6 +12,7 @@
 //! Limits: a group's `opacity`, `filter`, `mask` or `clip-path` is applied to each segment's
 //! part of the group separately, not to the group as a whole, when a mesh fill splits it.
 
+use std::collections::HashSet;
 use std::ops::Range;
 
 use gradmesh::render::{self, Image, PictureLayer, RenderOptions};
@@ -51,6 +52,8 @@ struct Edit {
 
 /// The drawn elements of a document in paint order, and which of them are mesh-filled shapes.
 struct DrawnElements<'a, 'input> {
+    /// The ids of the document's mesh gradients.
+    mesh_ids: HashSet<&'a str>,
     elements: Vec<Node<'a, 'input>>,
     /// Indices into `elements` of the shapes whose fill is a mesh gradient, bottom first.
     mesh_shapes: Vec<usize>,
@@ -71,8 +74,8 @@ fn own_property<'a>(node: Node<'a, '_>, name: &str) -> Option<&'a str> {
     from_style.or_else(|| node.attribute(name).map(str::trim))
 }
 
-/// Whether the (inherited) fill of `node` names a mesh gradient.
-fn fills_with_mesh(doc: &Document, node: Node) -> bool {
+/// Whether the (inherited) fill of `node` names one of `mesh_ids`.
+fn fills_with_mesh(mesh_ids: &HashSet<&str>, node: Node) -> bool {
     let Some(fill) = node.ancestors().find_map(|n| own_property(n, "fill")) else {
         return false;
     };
@@ -83,25 +86,19 @@ fn fills_with_mesh(doc: &Document, node: Node) -> bool {
     else {
         return false;
     };
-    doc.descendants()
-        .find(|n| n.attribute("id") == Some(id))
-        .is_some_and(|g| g.tag_name().name().eq_ignore_ascii_case("meshgradient"))
+    mesh_ids.contains(id)
 }
 
-fn collect<'a, 'input>(
-    doc: &Document<'input>,
-    node: Node<'a, 'input>,
-    out: &mut DrawnElements<'a, 'input>,
-) {
+fn collect<'a, 'input>(node: Node<'a, 'input>, out: &mut DrawnElements<'a, 'input>) {
     for child in node.children().filter(|c| is_svg(*c)) {
         let name = child.tag_name().name();
         if NOT_DRAWN.contains(&name) || own_property(child, "display") == Some("none") {
             continue;
         }
         match name {
-            "g" | "a" | "switch" => collect(doc, child, out),
+            "g" | "a" | "switch" => collect(child, out),
             _ => {
-                if SHAPES.contains(&name) && fills_with_mesh(doc, child) {
+                if SHAPES.contains(&name) && fills_with_mesh(&out.mesh_ids, child) {
                     out.mesh_shapes.push(out.elements.len());
                 }
                 out.elements.push(child);
@@ -192,11 +189,17 @@ fn segment_texts(text: &str, fills: usize, opts: &RenderOptions) -> Result<Vec<S
         },
     )
     .map_err(|e| e.to_string())?;
+    let mesh_ids = doc
+        .descendants()
+        .filter(|n| n.tag_name().name().eq_ignore_ascii_case("meshgradient"))
+        .filter_map(|n| n.attribute("id"))
+        .collect();
     let mut drawn = DrawnElements {
+        mesh_ids,
         elements: Vec::new(),
         mesh_shapes: Vec::new(),
     };
-    collect(&doc, doc.root_element(), &mut drawn);
+    collect(doc.root_element(), &mut drawn);
     if drawn.mesh_shapes.len() != fills {
         return Err(format!(
             "{} shapes name a mesh gradient as fill, but {fills} mesh fills were read",
@@ -251,6 +254,49 @@ fn render_segment(
     Ok(pixmap)
 }
 
+/// resvg's options: the system's fonts, and for each generic family (and text that names no
+/// font) the first of some common metric-compatible families that the system has, as the
+/// defaults (Times New Roman, Arial, Courier New) are often missing on Linux.
+fn resvg_options() -> resvg::usvg::Options<'static> {
+    let mut options = resvg::usvg::Options::default();
+    let db = options.fontdb_mut();
+    db.load_system_fonts();
+    let installed: HashSet<String> = db
+        .faces()
+        .flat_map(|f| f.families.iter().map(|(name, _)| name.clone()))
+        .collect();
+    let first = |names: &[&str]| {
+        names
+            .iter()
+            .find(|n| installed.contains(**n))
+            .map(|n| n.to_string())
+    };
+    let serif = first(&[
+        "Times New Roman",
+        "Liberation Serif",
+        "Nimbus Roman",
+        "DejaVu Serif",
+    ]);
+    let sans = first(&["Arial", "Liberation Sans", "Nimbus Sans", "DejaVu Sans"]);
+    let mono = first(&[
+        "Courier New",
+        "Liberation Mono",
+        "Nimbus Mono PS",
+        "DejaVu Sans Mono",
+    ]);
+    if let Some(name) = &sans {
+        db.set_sans_serif_family(name.clone());
+    }
+    if let Some(name) = &mono {
+        db.set_monospace_family(name.clone());
+    }
+    if let Some(name) = serif {
+        db.set_serif_family(name.clone());
+        options.font_family = name;
+    }
+    options
+}
+
 /// `over` (premultiplied RGBA8) composited over `acc` (premultiplied `f32`).
 fn composite_pixmap(acc: &mut [f32], over: &resvg::tiny_skia::Pixmap) {
     for (a, p) in acc.chunks_exact_mut(4).zip(over.data().chunks_exact(4)) {
@@ -285,8 +331,7 @@ pub fn render_whole_picture(
         Ok(s) => s,
         Err(message) => return Ok(Err(message)),
     };
-    let mut options = resvg::usvg::Options::default();
-    options.fontdb_mut().load_system_fonts();
+    let options = resvg_options();
     let mut acc = vec![0.0f32; 4 * opts.width as usize * opts.height as usize];
     if let Some(bg) = opts.background {
         let alpha = bg[3].clamp(0.0, 1.0) as f32;
