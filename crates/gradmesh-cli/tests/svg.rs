@@ -171,10 +171,8 @@ fn every_test_file_round_trips_through_json_and_renders_both_ways() {
         );
         // The JSON keeps the root's user units: drawn with the SVG's view box.
         let text = std::fs::read_to_string(&svg).unwrap();
-        let view = gradmesh::formats::svg::read_svg(&text)
-            .unwrap()
-            .view_rect()
-            .unwrap();
+        let scene = gradmesh::formats::svg::read_svg(&text).unwrap();
+        let view = scene.view_rect().unwrap();
         let numbers = [w, h]
             .map(|v| v.to_string())
             .into_iter()
@@ -213,12 +211,166 @@ fn every_test_file_round_trips_through_json_and_renders_both_ways() {
             disagree * 50 < covered || name == "meshgradient-complex-001",
             "{name}: classic and scheme coverage differ on {disagree} of {covered} pixels"
         );
+        // The meshes alone (the command draws the rest of the picture too).
+        let opts =
+            gradmesh::render::RenderOptions::new(w, h, gradmesh::render::View::from_rect(view));
+        let meshes = gradmesh::render::render_svg_scene(
+            &scene,
+            gradmesh::render::SvgMeshRendering::Scheme,
+            &opts,
+        )
+        .unwrap()
+        .0
+        .to_u8(true);
         let uncovered = (0..pixels)
-            .filter(|&i| alpha(&scheme_px, i) == 255 && alpha(&json_px, i) < 255)
+            .filter(|&i| alpha(&meshes, i) == 255 && alpha(&json_px, i) < 255)
             .count();
         assert_eq!(
             uncovered, 0,
             "{name}: the JSON leaves pixels of the SVG uncovered"
         );
+    }
+}
+
+/// The CIEDE2000 difference of two sRGB colours (8-bit channels).
+fn delta_e(a: &[u8], b: &[u8]) -> f64 {
+    use gradmesh::ColourSpace;
+    use palette::color_difference::Ciede2000;
+    use palette::white_point::D65;
+    use palette::Lab;
+    let lab = |p: &[u8]| {
+        let rgb = [p[0], p[1], p[2]].map(|c| f64::from(c) / 255.0);
+        let c = ColourSpace::Srgb.convert(ColourSpace::Lab, rgb);
+        Lab::<D65, f64>::new(c[0], c[1], c[2])
+    };
+    lab(a).difference(lab(b))
+}
+
+fn inkscape_render(name: &str) -> (u32, u32, Vec<u8>) {
+    decode_png(
+        &sample("../inkscape-1.2.2-renders")
+            .join(name)
+            .with_extension("png"),
+    )
+}
+
+/// How the whole picture of `name` compares with Inkscape's render: the share of pixels
+/// covered (alpha at least half) in both or neither, and the ΔE00 mean and largest share of
+/// pixels far off over the pixels where Inkscape painted within ΔE00 `near` of `colour`
+/// (content resvg draws: a flat fill, a stroke), at least `min_pixels` of them.
+fn whole_picture_against_inkscape(
+    name: &str,
+    colour: [u8; 3],
+    near: f64,
+    min_pixels: usize,
+) -> (f64, f64, usize) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("whole.png");
+    let run = gradmesh(&[
+        "render",
+        sample(&format!("{name}.svg")).to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{run:?}");
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!stderr.contains("left out: only"), "{name}: {stderr}");
+    let (w, h, ours) = decode_png(&out);
+    let (iw, ih, theirs) = inkscape_render(name);
+    assert_eq!((w, h), (iw, ih), "{name}");
+    let covered = |p: &[u8]| p[3] >= 128;
+    let pixels = || ours.chunks_exact(4).zip(theirs.chunks_exact(4));
+    let agree = pixels().filter(|(a, b)| covered(a) == covered(b)).count();
+    let coverage = agree as f64 / (w * h) as f64;
+    let flat: Vec<f64> = pixels()
+        .filter(|(_, b)| b[3] == 255 && delta_e(b, &colour) < near)
+        .map(|(a, b)| delta_e(a, b))
+        .collect();
+    let mean = flat.iter().sum::<f64>() / flat.len() as f64;
+    eprintln!(
+        "{name}: coverage agreement {:.4}, {} pixels near {colour:?}: ΔE00 mean {mean:.3}, {} above 5",
+        coverage,
+        flat.len(),
+        flat.iter().filter(|d| **d > 5.0).count()
+    );
+    assert!(
+        flat.len() >= min_pixels,
+        "{name}: {} pixels near {colour:?}",
+        flat.len()
+    );
+    (coverage, mean, flat.iter().filter(|d| **d > 5.0).count())
+}
+
+/// sample3: a flat ellipse beneath the meshes and a stroked path over its own mesh fill;
+/// sample1: an ellipse over a mesh. Their whole pictures match Inkscape's renders.
+#[test]
+fn svg_whole_picture_matches_inkscape() {
+    // sample3: the ellipse (#80ffb3) beneath, the black stroke of the mesh-filled path.
+    let (coverage, mean, _) =
+        whole_picture_against_inkscape("sample3", [0x80, 0xff, 0xb3], 1.0, 10_000);
+    assert!(coverage > 0.99, "sample3 coverage {coverage}");
+    assert!(mean < 1.0, "sample3 ellipse ΔE00 mean {mean}");
+    let (_, mean, _) = whole_picture_against_inkscape("sample3", [0, 0, 0], 10.0, 30);
+    assert!(mean < 5.0, "sample3 stroke ΔE00 mean {mean}");
+    // sample1: the ellipse over the mesh.
+    let (w, _, inkscape) = inkscape_render("sample1");
+    let probe = 4 * (230 * w as usize + 230);
+    let brown = [inkscape[probe], inkscape[probe + 1], inkscape[probe + 2]];
+    let (coverage, mean, _) = whole_picture_against_inkscape("sample1", brown, 1.0, 10_000);
+    assert!(coverage > 0.99, "sample1 coverage {coverage}");
+    assert!(mean < 1.0, "sample1 ellipse ΔE00 mean {mean}");
+}
+
+const PAINT_ORDER: &str = r##"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100" viewBox="0 0 50 50">
+  <defs><meshgradient id="blue" x="10" y="10" gradientUnits="userSpaceOnUse"><meshrow><meshpatch>
+    <stop path="l 30,0" stop-color="#00f"/><stop path="l 0,30" stop-color="#00f"/>
+    <stop path="l -30,0" stop-color="#00f"/><stop path="l 0,-30" stop-color="#00f"/>
+  </meshpatch></meshrow></meshgradient></defs>
+  <rect x="0" y="0" width="25" height="25" fill="#f00"/>
+  <g><rect x="10" y="10" width="30" height="30" style="fill:url(#blue)" stroke="#000" stroke-width="2"/></g>
+  <circle cx="40" cy="40" r="6" fill="#0f0"/>
+</svg>"##;
+
+/// A rect beneath a mesh fill, its stroke over it, and a circle above: each pixel shows the
+/// topmost paint, at 8 and 16 bits and on a background.
+#[test]
+fn svg_whole_picture_keeps_paint_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("order.svg");
+    std::fs::write(&input, PAINT_ORDER).unwrap();
+    for (bits, background) in [("8", None), ("16", Some("#ffff00"))] {
+        let out = dir.path().join(format!("order{bits}.png"));
+        let mut args = vec![
+            "render",
+            input.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--bits",
+            bits,
+        ];
+        if let Some(bg) = background {
+            args.extend(["--background", bg]);
+        }
+        let run = gradmesh(&args);
+        assert!(run.status.success(), "{run:?}");
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(!stderr.contains("left out"), "{stderr}");
+        let (w, h, px) = decode_png(&out);
+        assert_eq!((w, h), (100, 100));
+        // Pixel coordinates are user units times 2.
+        let at = |x: usize, y: usize| &px[4 * (y * 100 + x)..4 * (y * 100 + x) + 4];
+        assert_eq!(at(10, 10), [255, 0, 0, 255], "the rect alone");
+        assert_eq!(at(40, 40), [0, 0, 255, 255], "the mesh over the rect");
+        assert_eq!(
+            at(20, 50),
+            [0, 0, 0, 255],
+            "the mesh shape's stroke over its fill"
+        );
+        assert_eq!(at(80, 80), [0, 255, 0, 255], "the circle over the mesh");
+        let empty = match background {
+            Some(_) => [255, 255, 0, 255],
+            None => [0, 0, 0, 0],
+        };
+        assert_eq!(at(90, 10), empty, "nothing painted");
     }
 }

@@ -6,6 +6,7 @@ mod info;
 mod refine;
 mod render;
 mod serve;
+mod whole_picture;
 
 use std::path::Path;
 
@@ -42,7 +43,9 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
 /// Reads a document within `limits`, with errors located in the file. An SVG file's warnings
 /// (what was left out) are printed.
 fn read(path: &Path, limits: &gradmesh::Limits) -> Result<Document, Error> {
-    Ok(read_with_viewport(path, limits)?.document)
+    let input = read_with_viewport(path, limits)?;
+    print_warnings(path, &input.warnings);
+    Ok(input.document)
 }
 
 /// The part of the plane a file shows and the picture's size in pixels, where the file says
@@ -55,6 +58,8 @@ struct Input {
     document: Document,
     viewport: Option<Viewport>,
     fills: Option<Vec<gradmesh::formats::svg::MeshFill>>,
+    /// What an SVG file held that was left out of `document`, for the caller to print.
+    warnings: Vec<gradmesh::Warning>,
 }
 
 /// [`read`], with the file's [`Viewport`] and fills when it has them.
@@ -62,7 +67,6 @@ fn read_with_viewport(path: &Path, limits: &gradmesh::Limits) -> Result<Input, E
     use gradmesh::formats::{svg, Format};
     if Format::from_path(path) == Some(Format::Svg) {
         let read = svg::read_path_with_limits(path, limits)?;
-        print_warnings(path, &read.warnings);
         let viewport = read
             .view
             .map(gradmesh::render::View::from_rect)
@@ -71,12 +75,14 @@ fn read_with_viewport(path: &Path, limits: &gradmesh::Limits) -> Result<Input, E
             document: read.document,
             viewport,
             fills: Some(read.fills),
+            warnings: read.warnings,
         });
     }
     Ok(Input {
         document: gradmesh::formats::read_path_with_limits(path, limits)?,
         viewport: None,
         fills: None,
+        warnings: Vec::new(),
     })
 }
 
@@ -99,7 +105,7 @@ fn check_not_input(output: &Path, inputs: &[&Path], force: bool) -> Result<(), E
 }
 
 /// Prints warnings to standard error.
-fn print_warnings(path: &Path, warnings: &[gradmesh::Warning]) {
+pub(super) fn print_warnings(path: &Path, warnings: &[gradmesh::Warning]) {
     for w in warnings {
         eprintln!("gradmesh: warning: {}: {w}", path.display());
     }

@@ -13,6 +13,8 @@ use gradmesh::{ColourSpace, Document, Error, ErrorKind};
 
 use crate::args::RenderArgs;
 
+use super::whole_picture;
+
 fn invalid(what: &str, message: String) -> Error {
     Error::new(ErrorKind::Invalid {
         what: what.into(),
@@ -109,11 +111,14 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     let mut viewport = None;
     // For each layer: the SVG fill it was converted from, if any.
     let mut fills = Vec::new();
+    // What the inputs left out, printed once it is known whether resvg draws it.
+    let mut left_out = Vec::new();
     for (k, path) in args.inputs.iter().enumerate() {
         let read = super::read_with_viewport(path, &limits)?;
         if k == 0 {
             viewport = read.viewport;
         }
+        left_out.push((path.as_path(), read.warnings));
         let layers = read.document.layers;
         origins.extend((0..layers.len()).map(|i| (path.as_path(), i)));
         match read.fills {
@@ -133,6 +138,13 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     };
 
     let opts = options(args, &doc, viewport)?;
+    // A lone SVG input rendered to PNG is drawn whole: resvg draws what is not a mesh fill.
+    let whole = kind == Output::Png && args.inputs.len() == 1 && fills.iter().any(Option::is_some);
+    if !whole {
+        for (path, warnings) in &left_out {
+            super::print_warnings(path, warnings);
+        }
+    }
     if kind != Output::Png {
         let pdf = kind == Output::Pdf;
         return vector(args, &doc, &opts, pdf, &origins, read).map_err(locate);
@@ -145,7 +157,30 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     // image): an `f32` image is four times the memory of 8-bit output.
     let picture = picture_layers(&doc, &fills, args.svg_mesh.into());
     let picture = picture.as_deref();
-    let (pixels, info) = if args.boundary {
+    let whole_picture = match (whole, picture) {
+        (true, Some(layers)) => {
+            let path = &args.inputs[0];
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| Error::new(ErrorKind::Io(format!("{}: {e}", path.display()))))?;
+            let drawn =
+                whole_picture::render_whole_picture(&text, layers, &opts).map_err(locate)?;
+            print_left_out(path, &left_out[0].1, drawn.is_ok());
+            if let Err(message) = &drawn {
+                eprintln!(
+                    "gradmesh: warning: {}: only the mesh fills are drawn: {message}",
+                    path.display()
+                );
+            }
+            drawn.ok()
+        }
+        _ => None,
+    };
+    let (pixels, info) = if let Some((mut image, info)) = whole_picture {
+        if args.boundary {
+            render::draw_outlines(&doc, &opts, &mut image).map_err(locate)?;
+        }
+        (Pixels::Float(image), info)
+    } else if args.boundary {
         let mut image = render::Image::new(opts.width, opts.height);
         let info = draw(&doc, picture, &opts, &mut image.data).map_err(locate)?;
         render::draw_outlines(&doc, &opts, &mut image).map_err(locate)?;
@@ -245,6 +280,17 @@ fn picture_layers<'a>(
             })
             .collect()
     })
+}
+
+/// Prints what an SVG file's reading left out, except the content resvg drew (`drawn`).
+fn print_left_out(path: &std::path::Path, warnings: &[gradmesh::Warning], drawn: bool) {
+    for w in warnings {
+        // The reader's words for content with other paints and elements other than shapes.
+        let resvg_draws_it = w.message.contains("left out: only");
+        if !(drawn && resvg_draws_it) {
+            eprintln!("gradmesh: warning: {}: {w}", path.display());
+        }
+    }
 }
 
 /// Draws `picture` when there is one, else `doc`, into `out`.

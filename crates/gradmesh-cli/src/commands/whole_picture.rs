@@ -1,0 +1,390 @@
+//! The whole picture of an SVG file: what is not a mesh-gradient fill is drawn by resvg, and
+//! the mesh fills are composited between it in paint order.
+//!
+//! The file's drawn elements are split at its mesh-filled shapes into segments: the elements
+//! below the first mesh fill, those between two fills, those above the last. Each segment is
+//! rendered by resvg from a copy of the text in which every drawn element outside the segment
+//! has `display:none`, and whose root shows the render's view at the render's size. A mesh
+//! shape's stroke is drawn at the start of the segment above its fill (its fill set to `none`).
+//! Segments and mesh layers are composited source-over with premultiplied alpha, in `f32`, on
+//! sRGB-encoded values (as resvg and Inkscape blend).
+//!
+//! Limits: a group's `opacity`, `filter`, `mask` or `clip-path` is applied to each segment's
+//! part of the group separately, not to the group as a whole, when a mesh fill splits it.
+
+use std::collections::HashSet;
+use std::ops::Range;
+
+use gradmesh::render::{self, Image, PictureLayer, RenderOptions};
+use gradmesh::Error;
+use roxmltree::{Document, Node};
+
+const SVG_NS: &str = "http://www.w3.org/2000/svg";
+
+/// Elements never drawn where they stand, or that draw nothing: not hidden, not segments.
+const NOT_DRAWN: &[&str] = &[
+    "defs",
+    "clipPath",
+    "mask",
+    "pattern",
+    "marker",
+    "symbol",
+    "linearGradient",
+    "radialGradient",
+    "meshgradient",
+    "meshGradient",
+    "filter",
+    "style",
+    "script",
+    "title",
+    "desc",
+    "metadata",
+];
+
+/// The shapes gradmesh reads mesh fills from (`formats::svg`'s list).
+const SHAPES: &[&str] = &["rect", "circle", "ellipse", "polygon", "polyline", "path"];
+
+/// One text edit: `range` of the original text is replaced by `with`.
+struct Edit {
+    range: Range<usize>,
+    with: String,
+}
+
+/// The drawn elements of a document in paint order, and which of them are mesh-filled shapes.
+struct DrawnElements<'a, 'input> {
+    /// The ids of the document's mesh gradients.
+    mesh_ids: HashSet<&'a str>,
+    elements: Vec<Node<'a, 'input>>,
+    /// Indices into `elements` of the shapes whose fill is a mesh gradient, bottom first.
+    mesh_shapes: Vec<usize>,
+}
+
+fn is_svg(node: Node) -> bool {
+    node.is_element() && matches!(node.tag_name().namespace(), None | Some(SVG_NS))
+}
+
+/// The value of presentation property `name` set on `node` itself (its `style` wins).
+fn own_property<'a>(node: Node<'a, '_>, name: &str) -> Option<&'a str> {
+    let from_style = node.attribute("style").and_then(|style| {
+        style.split(';').rev().find_map(|decl| {
+            let (key, value) = decl.split_once(':')?;
+            (key.trim() == name).then(|| value.trim())
+        })
+    });
+    from_style.or_else(|| node.attribute(name).map(str::trim))
+}
+
+/// Whether the (inherited) fill of `node` names one of `mesh_ids`.
+fn fills_with_mesh(mesh_ids: &HashSet<&str>, node: Node) -> bool {
+    let Some(fill) = node.ancestors().find_map(|n| own_property(n, "fill")) else {
+        return false;
+    };
+    let Some(id) = fill
+        .strip_prefix("url(")
+        .and_then(|rest| rest.split(')').next())
+        .map(|iri| iri.trim().trim_matches(['"', '\'']).trim_start_matches('#'))
+    else {
+        return false;
+    };
+    mesh_ids.contains(id)
+}
+
+fn collect<'a, 'input>(node: Node<'a, 'input>, out: &mut DrawnElements<'a, 'input>) {
+    for child in node.children().filter(|c| is_svg(*c)) {
+        let name = child.tag_name().name();
+        if NOT_DRAWN.contains(&name) || own_property(child, "display") == Some("none") {
+            continue;
+        }
+        match name {
+            "g" | "a" | "switch" => collect(child, out),
+            _ => {
+                if SHAPES.contains(&name) && fills_with_mesh(&out.mesh_ids, child) {
+                    out.mesh_shapes.push(out.elements.len());
+                }
+                out.elements.push(child);
+            }
+        }
+    }
+}
+
+/// An edit that appends `declaration` to the `style` of `node` (adding the attribute if need be).
+fn add_style(node: Node, text: &str, declaration: &str) -> Edit {
+    match node.attribute_node("style") {
+        Some(style) => {
+            let end = style.range_value().end;
+            Edit {
+                range: end..end,
+                with: format!(";{declaration}"),
+            }
+        }
+        None => {
+            let start = node.range().start + 1;
+            let name_end = text[start..]
+                .find(|c: char| c.is_whitespace() || c == '/' || c == '>')
+                .map_or(text.len(), |n| start + n);
+            Edit {
+                range: name_end..name_end,
+                with: format!(" style=\"{declaration}\""),
+            }
+        }
+    }
+}
+
+/// Edits of the root that make it show `opts.view` at `opts.width` x `opts.height` pixels.
+fn root_view(root: Node, text: &str, opts: &RenderOptions) -> Vec<Edit> {
+    let mut edits: Vec<Edit> = root
+        .attributes()
+        .filter(|a| {
+            a.namespace().is_none()
+                && ["width", "height", "viewBox", "preserveAspectRatio"].contains(&a.name())
+        })
+        .map(|a| Edit {
+            range: a.range(),
+            with: String::new(),
+        })
+        .collect();
+    let v = opts.view;
+    let start = root.range().start + 1;
+    let name_end = start
+        + text[start..]
+            .find(|c: char| c.is_whitespace() || c == '/' || c == '>')
+            .unwrap_or(0);
+    edits.push(Edit {
+        range: name_end..name_end,
+        with: format!(
+            " width=\"{}\" height=\"{}\" viewBox=\"{} {} {} {}\" preserveAspectRatio=\"none\"",
+            opts.width,
+            opts.height,
+            v.x0,
+            v.y0,
+            v.width(),
+            v.height()
+        ),
+    });
+    edits
+}
+
+fn apply(text: &str, mut edits: Vec<Edit>) -> String {
+    edits.sort_by_key(|e| (e.range.start, e.range.end));
+    let mut out = String::with_capacity(text.len() + 32 * edits.len());
+    let mut at = 0;
+    for e in edits {
+        out.push_str(&text[at..e.range.start]);
+        out.push_str(&e.with);
+        at = e.range.end;
+    }
+    out.push_str(&text[at..]);
+    out
+}
+
+/// The texts of the segments of `text` (`fills + 1` of them, bottom first), each showing
+/// `opts.view` at the render's size. An error message when the file's mesh-filled shapes are
+/// not the `fills` that gradmesh read.
+fn segment_texts(text: &str, fills: usize, opts: &RenderOptions) -> Result<Vec<String>, String> {
+    let doc = Document::parse_with_options(
+        text,
+        roxmltree::ParsingOptions {
+            allow_dtd: true,
+            ..Default::default()
+        },
+    )
+    .map_err(|e| e.to_string())?;
+    let mesh_ids = doc
+        .descendants()
+        .filter(|n| n.tag_name().name().eq_ignore_ascii_case("meshgradient"))
+        .filter_map(|n| n.attribute("id"))
+        .collect();
+    let mut drawn = DrawnElements {
+        mesh_ids,
+        elements: Vec::new(),
+        mesh_shapes: Vec::new(),
+    };
+    collect(doc.root_element(), &mut drawn);
+    if drawn.mesh_shapes.len() != fills {
+        return Err(format!(
+            "{} shapes name a mesh gradient as fill, but {fills} mesh fills were read",
+            drawn.mesh_shapes.len()
+        ));
+    }
+    let root = root_view(doc.root_element(), text, opts);
+    let bounds: Vec<usize> = drawn
+        .mesh_shapes
+        .iter()
+        .copied()
+        .chain([usize::MAX])
+        .collect();
+    let mut texts = Vec::with_capacity(fills + 1);
+    for (s, &end) in bounds.iter().enumerate() {
+        // Segment `s` runs from mesh shape `s - 1` (its stroke only) to below mesh shape `s`.
+        let start = if s == 0 { None } else { Some(bounds[s - 1]) };
+        let mut edits: Vec<Edit> = root
+            .iter()
+            .map(|e| Edit {
+                range: e.range.clone(),
+                with: e.with.clone(),
+            })
+            .collect();
+        for (i, node) in drawn.elements.iter().enumerate() {
+            let inside = start.is_none_or(|b| i >= b) && i < end;
+            if Some(i) == start {
+                edits.push(add_style(*node, text, "fill:none"));
+            } else if !inside || drawn.mesh_shapes.contains(&i) {
+                edits.push(add_style(*node, text, "display:none"));
+            }
+        }
+        texts.push(apply(text, edits));
+    }
+    Ok(texts)
+}
+
+/// Renders one segment's text with resvg into a premultiplied RGBA8 pixmap.
+fn render_segment(
+    text: &str,
+    options: &resvg::usvg::Options,
+    opts: &RenderOptions,
+) -> Result<resvg::tiny_skia::Pixmap, String> {
+    let tree = resvg::usvg::Tree::from_str(text, options).map_err(|e| e.to_string())?;
+    let mut pixmap = resvg::tiny_skia::Pixmap::new(opts.width, opts.height)
+        .ok_or_else(|| format!("resvg cannot allocate {}x{}", opts.width, opts.height))?;
+    resvg::render(
+        &tree,
+        resvg::tiny_skia::Transform::identity(),
+        &mut pixmap.as_mut(),
+    );
+    Ok(pixmap)
+}
+
+/// resvg's options: the system's fonts, and for each generic family (and text that names no
+/// font) the first of some common metric-compatible families that the system has, as the
+/// defaults (Times New Roman, Arial, Courier New) are often missing on Linux.
+fn resvg_options() -> resvg::usvg::Options<'static> {
+    let mut options = resvg::usvg::Options::default();
+    let db = options.fontdb_mut();
+    db.load_system_fonts();
+    let installed: HashSet<String> = db
+        .faces()
+        .flat_map(|f| f.families.iter().map(|(name, _)| name.clone()))
+        .collect();
+    let first = |names: &[&str]| {
+        names
+            .iter()
+            .find(|n| installed.contains(**n))
+            .map(|n| n.to_string())
+    };
+    let serif = first(&[
+        "Times New Roman",
+        "Liberation Serif",
+        "Nimbus Roman",
+        "DejaVu Serif",
+    ]);
+    let sans = first(&["Arial", "Liberation Sans", "Nimbus Sans", "DejaVu Sans"]);
+    let mono = first(&[
+        "Courier New",
+        "Liberation Mono",
+        "Nimbus Mono PS",
+        "DejaVu Sans Mono",
+    ]);
+    if let Some(name) = &sans {
+        db.set_sans_serif_family(name.clone());
+    }
+    if let Some(name) = &mono {
+        db.set_monospace_family(name.clone());
+    }
+    if let Some(name) = serif {
+        db.set_serif_family(name.clone());
+        options.font_family = name;
+    }
+    options
+}
+
+/// `over` (premultiplied RGBA8) composited over `acc` (premultiplied `f32`).
+fn composite_pixmap(acc: &mut [f32], over: &resvg::tiny_skia::Pixmap) {
+    for (a, p) in acc.chunks_exact_mut(4).zip(over.data().chunks_exact(4)) {
+        let alpha = p[3] as f32 / 255.0;
+        for c in 0..4 {
+            a[c] = p[c] as f32 / 255.0 + a[c] * (1.0 - alpha);
+        }
+    }
+}
+
+/// `over` (straight `f32`) composited over `acc` (premultiplied `f32`).
+fn composite_image(acc: &mut [f32], over: &[f32]) {
+    for (a, p) in acc.chunks_exact_mut(4).zip(over.chunks_exact(4)) {
+        let alpha = p[3];
+        for c in 0..3 {
+            a[c] = p[c] * alpha + a[c] * (1.0 - alpha);
+        }
+        a[3] = alpha + a[3] * (1.0 - alpha);
+    }
+}
+
+/// The whole picture of SVG `text`: `mesh_layers` (its mesh fills, bottom first, as gradmesh
+/// read them) between the rest of its content drawn by resvg, on `opts.background`. Straight
+/// alpha, like every [`Image`]. `Ok(Err(message))` when the file's content cannot be split
+/// around its mesh fills (the caller then draws the meshes alone).
+pub fn render_whole_picture(
+    text: &str,
+    mesh_layers: &[PictureLayer<'_>],
+    opts: &RenderOptions,
+) -> Result<Result<(Image, render::RenderInfo), String>, Error> {
+    let segments = match segment_texts(text, mesh_layers.len(), opts) {
+        Ok(s) => s,
+        Err(message) => return Ok(Err(message)),
+    };
+    let options = resvg_options();
+    let mut acc = vec![0.0f32; 4 * opts.width as usize * opts.height as usize];
+    if let Some(bg) = opts.background {
+        let alpha = bg[3].clamp(0.0, 1.0) as f32;
+        for px in acc.chunks_exact_mut(4) {
+            for c in 0..3 {
+                px[c] = bg[c].clamp(0.0, 1.0) as f32 * alpha;
+            }
+            px[3] = alpha;
+        }
+    }
+    let mut layer_opts = opts.clone();
+    layer_opts.background = None;
+    let mut info = render::RenderInfo::default();
+    let mut layer = Image::new(opts.width, opts.height);
+    for (s, segment) in segments.iter().enumerate() {
+        match render_segment(segment, &options, opts) {
+            Ok(pixmap) => composite_pixmap(&mut acc, &pixmap),
+            Err(message) => return Ok(Err(message)),
+        }
+        if let Some(mesh) = mesh_layers.get(s) {
+            layer.data.fill(0.0);
+            let drawn = render::render_picture_into(
+                std::slice::from_ref(mesh),
+                &layer_opts,
+                &mut layer.data,
+            )?;
+            merge_info(&mut info, drawn, s);
+            composite_image(&mut acc, &layer.data);
+        }
+    }
+    for px in acc.chunks_exact_mut(4) {
+        if px[3] > 0.0 {
+            for c in 0..3 {
+                px[c] = (px[c] / px[3]).clamp(0.0, 1.0);
+            }
+        }
+    }
+    let image = Image {
+        width: opts.width,
+        height: opts.height,
+        data: acc,
+    };
+    Ok(Ok((image, info)))
+}
+
+/// Adds the report of one mesh layer's render (layer `index` of the picture) to `info`.
+fn merge_info(info: &mut render::RenderInfo, drawn: render::RenderInfo, index: usize) {
+    info.timings.prepare += drawn.timings.prepare;
+    info.timings.draw += drawn.timings.draw;
+    info.layers.extend(drawn.layers);
+    info.warnings
+        .extend(drawn.warnings.into_iter().map(|mut w| {
+            w.layer = w.layer.map(|_| index);
+            w
+        }));
+}
