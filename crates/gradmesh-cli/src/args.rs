@@ -329,6 +329,10 @@ pub struct RenderArgs {
     /// Interpolate colour linearly over every triangle (no quadratic faces: more triangles).
     #[arg(long)]
     pub linear_colour: bool,
+    /// Choose regular faces' cell counts from bounds of their control points instead of
+    /// measuring samples (more triangles; for comparison).
+    #[arg(long)]
+    pub plan_from_bounds: bool,
     /// Draw the outline of each mesh on top, one pixel wide.
     #[arg(long)]
     pub boundary: bool,

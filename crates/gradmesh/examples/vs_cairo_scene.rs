@@ -5,6 +5,8 @@
 //! cargo build --release -p gradmesh --example vs_cairo_scene
 //! RAYON_NUM_THREADS=1 valgrind --tool=cachegrind --cache-sim=no target/release/examples/vs_cairo_scene
 //! ```
+//!
+//! `--plan-from-bounds` sets [`RenderOptions::plan_from_bounds`].
 
 use gradmesh::render::{render_document_into, RenderOptions, View};
 
@@ -16,6 +18,7 @@ fn main() -> Result<(), gradmesh::Error> {
     let doc = wavy_grid::document();
     let mut opts = RenderOptions::new(SIZE, SIZE, View::new(0.0, 0.0, SIZE as f64, SIZE as f64));
     opts.dither = false;
+    opts.plan_from_bounds = std::env::args().any(|a| a == "--plan-from-bounds");
     let mut buffer = vec![0u8; 4 * (SIZE * SIZE) as usize];
     let info = render_document_into(&doc, &opts, &mut buffer)?;
     let layer = &info.layers[0];

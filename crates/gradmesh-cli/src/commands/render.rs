@@ -65,6 +65,7 @@ fn options(
     opts.level = args.level;
     opts.dither = !args.no_dither;
     opts.quadratic = !args.linear_colour;
+    opts.plan_from_bounds = args.plan_from_bounds;
     opts.max_pixels = args.max_pixels;
     Ok(opts)
 }

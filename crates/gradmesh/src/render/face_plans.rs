@@ -13,10 +13,11 @@ use crate::validate::VertexData;
 
 use super::each4;
 use super::measure::{measure_quad, Measure, QuadSamples, Thresholds};
+use super::patch_bounds::{plan_from_bounds, PatchBounds};
 use super::quadratic::{measure_cells, Cell};
 use super::view::ToPixels;
 use crate::limit_surface::patches::{
-    regular_corners, regular_patch_with, ControlGrid, Grid, LocalPatch, ShapeCache,
+    evaluate_patch, regular_corners, regular_patch_with, ControlGrid, Grid, LocalPatch, ShapeCache,
 };
 
 /// Quadratic colour is tried on a face only while its linear error is at most this many times
@@ -63,7 +64,7 @@ impl FaceSurface {
 
     fn grid(&mut self, n: usize) -> Option<Grid> {
         match self {
-            FaceSurface::Regular(cp) => Some(crate::limit_surface::patches::evaluate_patch(cp, n)),
+            FaceSurface::Regular(cp) => Some(evaluate_patch(cp, n)),
             FaceSurface::Local { patch, root } => patch.grid(*root, n),
         }
     }
@@ -493,6 +494,31 @@ impl<'a> FacePlanner<'a> {
         each4(|k| t.is_boundary_edge(t.face_edges(f)[k] as usize))
     }
 
+    /// Regular face `f`'s plan from the bounds of its control grid `cp`
+    /// ([`super::patch_bounds`]), where they are tight.
+    fn plan_from_bounds(&self, cp: &ControlGrid, f: usize) -> Option<Plan> {
+        let bounds = PatchBounds::new(cp, self.xf, self.th.space);
+        let chosen = plan_from_bounds(&bounds, self.th, self.boundary_sides(f), self.n_max)?;
+        let n = chosen.n;
+        let mut plan = Plan::one_cell(Vec::new());
+        plan.n = n;
+        plan.measured = chosen.figures;
+        plan.estimated = true;
+        if chosen.quadratic {
+            // The grid of `n` is read from the even points of the finer one.
+            let finer = evaluate_patch(cp, 2 * n);
+            if n == 1 {
+                plan.centre = Some(finer[4]);
+            }
+            plan.order = Order::Quadratic;
+            plan.finer = Some(finer);
+            plan.linear_colour = Some(chosen.linear_colour);
+        } else {
+            plan.grid = evaluate_patch(cp, n);
+        }
+        Some(plan)
+    }
+
     /// Plans face `f` on its `surface`: doubles its cells a side until they pass the measures
     /// (or are predicted to from the last level), with linear or quadratic pieces.
     fn plan_face(
@@ -502,6 +528,13 @@ impl<'a> FacePlanner<'a> {
         scratch: &mut PlanScratch,
     ) -> Option<Plan> {
         let off_image = surface.off_image(self.level, self.data, f, self.xf, self.th.size);
+        if let (FaceSurface::Regular(cp), false, true) =
+            (&*surface, off_image, self.th.plan_from_bounds)
+        {
+            if let Some(plan) = self.plan_from_bounds(cp, f) {
+                return Some(plan);
+            }
+        }
         // A regular patch's grid of two cells holds its grid of one (the same parameters and
         // arithmetic): evaluate it once and read its corners from it (the grid stays empty
         // until the face is known to need it on its own). Local refinement evaluates each

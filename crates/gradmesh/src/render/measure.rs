@@ -43,6 +43,8 @@ pub(super) struct Thresholds {
     pub space: ColourSpace,
     /// Whether faces may take quadratic colour ([`RenderOptions::quadratic`]).
     pub quadratic: bool,
+    /// Whether regular faces are planned from their bounds ([`RenderOptions::plan_from_bounds`]).
+    pub plan_from_bounds: bool,
 }
 
 impl Thresholds {
@@ -55,6 +57,7 @@ impl Thresholds {
             size: (opts.width as f64, opts.height as f64),
             space,
             quadratic: opts.quadratic,
+            plan_from_bounds: opts.plan_from_bounds,
         }
     }
 }

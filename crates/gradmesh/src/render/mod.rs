@@ -106,6 +106,7 @@ mod options;
 pub(crate) mod outline;
 mod output;
 mod overlay;
+mod patch_bounds;
 mod png_deflate;
 mod quadratic;
 mod stitch;

@@ -70,6 +70,13 @@ pub struct RenderOptions {
     /// that passes the colour tolerance with fewer cells than linear colour (default `true`).
     /// `false` draws every face with linear colour (more triangles), for comparison.
     pub quadratic: bool,
+    /// Choose the cell count of regular faces from bounds of their control points instead of
+    /// measuring samples (default `false`; faces near extraordinary vertices and creases, and
+    /// faces whose bounds are loose, are measured either way). The bounds hold over the whole
+    /// face where the measure samples cells' and sides' centres, so they ask for more cells:
+    /// at 1024 px the real artwork takes 2.5 to 7 times the triangles, and more instructions
+    /// in all than measuring. For comparison.
+    pub plan_from_bounds: bool,
 }
 
 impl Default for RenderOptions {
@@ -92,6 +99,7 @@ impl Default for RenderOptions {
             dither: true,
             max_pixels: MAX_PIXELS,
             quadratic: true,
+            plan_from_bounds: false,
         }
     }
 }

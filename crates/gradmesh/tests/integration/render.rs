@@ -237,7 +237,11 @@ fn control_colours_appear_at_their_limit_points() {
 /// The fast path against the reference rendering, at 16 bits: largest and mean CIEDE2000 over
 /// the interior pixels.
 fn compare_with_reference(name: &str, d: &Document, max_side: u32) -> (f64, f64) {
-    let mut opts = RenderOptions::fit(d, max_side);
+    compare_options_with_reference(name, d, RenderOptions::fit(d, max_side))
+}
+
+/// [`compare_with_reference`] of a render with `opts` (the reference's with `reference` set).
+fn compare_options_with_reference(name: &str, d: &Document, mut opts: RenderOptions) -> (f64, f64) {
     let (fast, info) = render_image(d, &opts).unwrap();
     opts.reference = true;
     let (reference, ref_info) = render_image(d, &opts).unwrap();
@@ -312,6 +316,29 @@ fn adaptive_path_matches_reference_on_irregular_features() {
         assert!(max <= 0.5, "{name}: max dE00 {max}");
         assert!(mean <= 0.05, "{name}: mean dE00 {mean}");
     }
+}
+
+/// Regular faces planned from the bounds of their control points
+/// ([`RenderOptions::plan_from_bounds`]) stay within the same tolerances of the reference mode,
+/// and the bounds, which hold over whole faces, give them at least as many cells in all as
+/// measuring does.
+#[test]
+fn faces_planned_from_bounds_match_reference() {
+    let (mut measured, mut bounded) = (0, 0);
+    for (name, mesh) in test_meshes().into_iter().chain(featured_meshes()) {
+        let d = doc(vec![mesh]);
+        let mut opts = RenderOptions::fit(&d, 200);
+        measured += render_image(&d, &opts).unwrap().1.layers[0].quads;
+        opts.plan_from_bounds = true;
+        bounded += render_image(&d, &opts).unwrap().1.layers[0].quads;
+        let (max, mean) = compare_options_with_reference(&format!("bounds-{name}"), &d, opts);
+        assert!(max <= 0.5, "{name}: max dE00 {max}");
+        assert!(mean <= 0.05, "{name}: mean dE00 {mean}");
+    }
+    assert!(
+        bounded > measured,
+        "{bounded} cells from bounds, {measured} measured"
+    );
 }
 
 /// No crack between faces of different densities: over an opaque background, every pixel whose
