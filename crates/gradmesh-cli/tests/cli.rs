@@ -524,6 +524,25 @@ fn render_writes_the_image_paths_pixels() {
     let expect = encode_png(&linear, PngDepth::Eight { dither: true }).unwrap();
     assert!(std::fs::read(&out).unwrap() == expect);
     assert!(expect != encode_png(&image, PngDepth::Eight { dither: true }).unwrap());
+    // `--plan-from-bounds` is the library's `plan_from_bounds: true`, and draws other pixels.
+    let mut opts = RenderOptions::new(240, height, view);
+    opts.plan_from_bounds = true;
+    let (bounded, _) = render_image(&doc, &opts).unwrap();
+    let out = dir.path().join("bounds.png");
+    let args = [
+        "render",
+        s(&input),
+        "-o",
+        s(&out),
+        "--width",
+        "240",
+        "--plan-from-bounds",
+    ];
+    let o = gradmesh(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let expect = encode_png(&bounded, PngDepth::Eight { dither: true }).unwrap();
+    assert!(std::fs::read(&out).unwrap() == expect);
+    assert!(expect != encode_png(&image, PngDepth::Eight { dither: true }).unwrap());
 }
 
 /// An absurd request: the command fails with exit status 1 (as every refused limit does) and

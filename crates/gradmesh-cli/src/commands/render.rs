@@ -361,6 +361,7 @@ fn warn_of_png_flags(args: &RenderArgs) {
         (args.bits != 8, "--bits"),
         (args.no_dither, "--no-dither"),
         (args.linear_colour, "--linear-colour"),
+        (args.plan_from_bounds, "--plan-from-bounds"),
         (args.boundary, "--boundary"),
         (args.colour_space.is_some(), "--colour-space"),
         (
