@@ -1,11 +1,14 @@
 //! A regular face's cell count chosen from its control points alone, as Cairo picks a patch's
 //! steps: no samples measured.
 //!
-//! A regular face is a uniform bicubic B-spline patch over the unit square. Its derivatives are
-//! B-splines of the control grid's differences with non-negative weights that sum to one, so
-//! each derivative is bounded by the largest difference of its kind: `|P_uu| <= max |Δ²_u P|`,
-//! `|P_uv| <= max |Δ_u Δ_v P|`, `|P_uuv| <= max |Δ²_u Δ_v P|`, and so on (parameter units of
-//! the face, positions in pixels through the view's scaling).
+//! A regular face is a uniform bicubic B-spline patch; over the face it is a bicubic Bézier
+//! patch, whose derivatives are Bernstein polynomials of its net's differences with
+//! non-negative weights that sum to one. So each derivative is bounded by the largest
+//! difference of its kind: `|P_uu| <= 6 max |Δ²_u b|`, `|P_uv| <= 9 max |Δ_u Δ_v b|`,
+//! `|P_uuv| <= 18 max |Δ²_u Δ_v b|`, and so on (parameter units of the face, positions in
+//! pixels through the view's scaling). Each attribute first loses the affine function of the
+//! screen position that matches its gradient at the face's centre: interpolation reproduces
+//! it exactly, and where colour follows the geometry the differences shrink severalfold.
 //!
 //! The triangles of a cell of side `h` show, at a pixel `x`, the interpolation in the plane of
 //! `g = C ∘ P⁻¹` (colour as a function of the screen position), so the error is that of
@@ -21,15 +24,22 @@
 //!   and `D³g[Jδ]³ = C'''[δ³] + 3 C''[δ, s''] + ∇g · (P'''[δ³] + 3 P''[δ, s''])` with
 //!   `s'' = -J⁻¹ P''[δ, δ]`.
 //!
-//! `σ` is the smallest singular value at the face's centre less the most the Jacobian can move
-//! from there (Weyl's inequality). Where it is small against the centre's (the surface folds,
-//! or a handle is nearly degenerate) the bound is loose and the face is measured instead
-//! ([`super::face_plans`]); so is a face whose bound asks for cells under a pixel, where the
+//! `σ` is the smallest of the Jacobian's least singular values at the centres of the face's
+//! quarters, less the most the Jacobian can move within a quarter (Weyl's inequality). Where
+//! it is under a quarter of the value at the face's centre (the surface may fold, or a handle
+//! is nearly degenerate) the bounds are loose and the face is measured instead
+//! ([`super::face_plans`]); so is a face whose bounds ask for cells under a pixel, where the
 //! measure's own rules (which cells count) decide.
 //!
 //! Colour errors are approximately in Lab units: in other working spaces the differences are
 //! scaled by the largest norm of the derivative to Lab over the box of the control points'
 //! colours (its corners and centre). Opacity counts 100 per unit, on its own.
+//!
+//! The bounds hold over the whole face, where the measure samples cells' and sides' centres:
+//! on the real artwork they come to about 3 to 4 times the measured error for linear colour
+//! and 10 to 20 times for quadratic, so they ask for several times the triangles, which is why
+//! [`RenderOptions::plan_from_bounds`](super::RenderOptions::plan_from_bounds) is off by
+//! default (figures in `docs/performance.md`).
 
 use crate::colour::ColourSpace;
 use crate::limit_surface::patches::ControlGrid;

@@ -4,6 +4,8 @@
 //!
 //! Slow (about two minutes in release mode): `cargo test --release -p gradmesh --test integration
 //! accuracy_1024 -- --ignored --nocapture` prints the figures of each file.
+//! `GRADMESH_PLAN_FROM_BOUNDS=1` checks the fast path with
+//! [`RenderOptions::plan_from_bounds`] set.
 
 use std::path::{Path, PathBuf};
 
@@ -102,6 +104,7 @@ fn compare_at(size: u32, space: Option<ColourSpace>, only: &str) {
         let mut opts = RenderOptions::fit(&doc, size);
         opts.dither = false;
         opts.colour_space_override = space;
+        opts.plan_from_bounds = std::env::var_os("GRADMESH_PLAN_FROM_BOUNDS").is_some();
         let fast = render_document(&doc, &opts).unwrap();
         opts.reference = true;
         let reference = render_document(&doc, &opts).unwrap();
