@@ -126,6 +126,34 @@ fn cached_renders_equal_fresh_ones_and_prepare_only_what_changed() {
     );
 }
 
+/// With regular faces planned from bounds ([`RenderOptions::plan_from_bounds`]), edits through
+/// the cache still give the pixels a render from scratch gives and keep the plans of the faces
+/// they leave alone; switching the option prepares every layer again.
+#[test]
+fn cached_renders_equal_fresh_ones_with_faces_planned_from_bounds() {
+    let mut doc = tucan();
+    let mut opts = options(&doc, 300);
+    let mut cache = RenderCache::new();
+    render_both(&doc, &opts, &mut cache);
+    opts.plan_from_bounds = true;
+    assert_eq!(render_both(&doc, &opts, &mut cache), [false; 6]);
+    let p = &mut doc.layers[3].points[5];
+    p.colour = [p.colour[0] * 0.8, p.colour[1] + 10.0, p.colour[2]];
+    let (reused, _) = render_both_counting(&doc, &opts, &mut cache);
+    assert_eq!(reused, [true, true, true, false, true, true]);
+    let p = &mut doc.layers[2].points[7];
+    p.position.x += 3.0;
+    assert_eq!(
+        render_both(&doc, &opts, &mut cache),
+        [true, true, false, true, true, true]
+    );
+    let p = &mut doc.layers[2].points[7];
+    p.position.x -= 3.0;
+    let (reused, faces) = render_both_counting(&doc, &opts, &mut cache);
+    assert_eq!(reused, [true, true, false, true, true, true]);
+    assert!(faces[2] > 0, "no face kept its plan: {faces:?}");
+}
+
 /// Renders with the cache into `P` pixels and from scratch, asserts they agree, and returns
 /// how many bands the cached render drew.
 fn drawn_bands<P: gradmesh::render::OutputPixel + Default + PartialEq + std::fmt::Debug>(

@@ -627,25 +627,30 @@ fn holes_are_empty() {
     assert_eq!(img.pixel(35, 100)[3], 1.0);
 }
 
-/// The same bits with one thread as with several.
+/// The same bits with one thread as with several, with faces measured or planned from bounds.
 #[test]
 fn deterministic_across_thread_counts() {
     let d = doc(vec![
         grid(4, 3, [0.0, 0.0, 400.0, 300.0], 0.2, soft_colour),
         star(Point::new(200.0, 150.0), 120.0),
     ]);
-    let opts = RenderOptions::fit(&d, 300);
-    let render = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| render_document(&d, &opts).unwrap())
-    };
-    let one = render(1);
-    save("layers", &one);
-    assert_eq!(one, render(4));
-    assert_eq!(one, render(3));
+    for plan_from_bounds in [false, true] {
+        let mut opts = RenderOptions::fit(&d, 300);
+        opts.plan_from_bounds = plan_from_bounds;
+        let render = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| render_document(&d, &opts).unwrap())
+        };
+        let one = render(1);
+        if !plan_from_bounds {
+            save("layers", &one);
+        }
+        assert_eq!(one, render(4));
+        assert_eq!(one, render(3));
+    }
 }
 
 /// All three output types agree with the float image.
