@@ -86,6 +86,8 @@ pub(super) struct PatchBounds {
     sigma_centre: f64,
     /// Colour, then opacity.
     attributes: [AttributeBounds; 2],
+    /// The box of the Bézier net on the screen, pixels: lower and upper corners.
+    screen_box: [[f64; 2]; 2],
 }
 
 /// A point of a Bézier net in the units of the bounds: position in pixels, colour scaled to
@@ -283,6 +285,15 @@ impl PatchBounds {
     /// The bounds of the patch `cp` drawn through `xf`, its colours in `space`.
     pub fn new(cp: &ControlGrid, xf: &ToPixels, space: ColourSpace) -> PatchBounds {
         let mut net = bezier_net(cp, xf, lab_scale(cp, space));
+        let mut screen_box = [[f64::INFINITY; 2], [f64::NEG_INFINITY; 2]];
+        for p in net.iter().flatten() {
+            // The net's positions are scaled but not shifted.
+            let at = [p[0] - xf.x0 * xf.sx, p[1] - xf.y0 * xf.sy];
+            for k in 0..2 {
+                screen_box[0][k] = screen_box[0][k].min(at[k]);
+                screen_box[1][k] = screen_box[1][k].max(at[k]);
+            }
+        }
         let centre = centre_derivatives(&along_u(&net), &along_v(&net));
         remove_affine_part(&mut net, centre);
         let du: [[Scaled; 3]; 4] = along_u(&net);
@@ -339,7 +350,15 @@ impl PatchBounds {
             sigma,
             sigma_centre,
             attributes: [attribute(1), attribute(2)],
+            screen_box,
         }
+    }
+
+    /// Whether the patch misses an image of `size` pixels: its Bézier net's convex hull,
+    /// which holds it, does.
+    pub fn off_image(&self, size: (f64, f64)) -> bool {
+        let (lo, hi) = (self.screen_box[0], self.screen_box[1]);
+        hi[0] < -1.0 || hi[1] < -1.0 || lo[0] > size.0 + 1.0 || lo[1] > size.1 + 1.0
     }
 
     /// Whether the bounds are tight enough to plan by: the Jacobian stays well away from
