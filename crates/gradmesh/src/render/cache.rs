@@ -85,6 +85,7 @@ impl RenderCache {
             gamut: GamutMapping::default(),
             blend: BlendSpace::default(),
             max_pixels: 0,
+            fused_drawing: true,
             ..opts.clone()
         }
     }

@@ -34,6 +34,10 @@ pub(super) struct Scratch {
     /// Premultiplied colour in the blend space. Single precision: compositing a few layers
     /// loses far less than a 16-bit step, and half the bytes keep a wide band in cache.
     colour: Vec<[f32; 4]>,
+    /// Pixels of the band already written to the output in their final form (the fused path,
+    /// see [`put_whole_block`]): their colour here is neither kept nor encoded. One byte each,
+    /// 0 or 1, so that a block's flags are tested with one load ([`block_flags`]).
+    encoded: Vec<u8>,
 }
 
 thread_local! {
@@ -74,6 +78,7 @@ impl Scratch {
             clip_accumulation: coverage::Accumulator::new(w, BAND),
             clip_coverage: vec![0.0; w],
             colour: vec![[0.0; 4]; w * BAND],
+            encoded: vec![0; w * BAND],
             run: Box::new(Run {
                 colour: [[0.0; RUN]; 3],
                 pixel: [0; RUN],
@@ -141,8 +146,11 @@ pub(super) fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
         // drawing some columns gives them the bits drawing all would.
         whole_rows: x0 == 0 && x1 == w,
     };
-    let dither = opts.dither && P::DITHERED;
-    let linear = opts.blend == BlendSpace::Linear;
+    let encoding = Encoding {
+        dither: opts.dither && P::DITHERED,
+        linear: opts.blend == BlendSpace::Linear,
+    };
+    let Encoding { dither, linear } = encoding;
 
     if layers.iter().all(|l| l.line_bins.get(band).is_empty())
         && fill_with_background(out, area, background, dither, linear)
@@ -160,8 +168,13 @@ pub(super) fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
         if opaque == (x1 - x0) * rows {
             break;
         }
+        let shading = Shading::of_layer(layer, opts, wide);
+        let fused = opts.fused_drawing.then_some(FusedOutput {
+            out: &mut *out,
+            encoding,
+        });
         let Some((made_opaque, farthest)) =
-            draw_layer::<P>(layer, band, area, opts, wide, fresh, s)
+            draw_layer::<P>(layer, band, area, &shading, fresh, s, fused)
         else {
             continue;
         };
@@ -173,7 +186,30 @@ pub(super) fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
     if let Some(bg) = background {
         put_background_under(colour, bg, area);
     }
-    encode_band(out, colour, area, dither, linear);
+    encode_band(out, colour, &s.encoded[..w * rows], area, encoding);
+}
+
+/// How the band's colour becomes output pixels: with dither noise, and from linear blending
+/// (sRGB-encoded on the way) or not.
+#[derive(Clone, Copy)]
+struct Encoding {
+    dither: bool,
+    linear: bool,
+}
+
+/// The band's output pixels, for the fused path to write whole blocks into.
+struct FusedOutput<'a, P> {
+    out: &'a mut [P],
+    encoding: Encoding,
+}
+
+/// One row's share of [`FusedOutput`]: the band's output, which of its pixels are written, and
+/// the row's index in the image.
+struct FusedRow<'a, P> {
+    out: &'a mut [P],
+    encoded: &'a mut [u8],
+    encoding: Encoding,
+    y: u32,
 }
 
 /// The pixels of a band being drawn: columns `x0..x1` of `rows` rows from `y0`, in an image
@@ -213,7 +249,7 @@ fn fill_with_background<P: OutputPixel>(
     true
 }
 
-/// Clears the colour and opacity of the band's pixels.
+/// Clears the colour, opacity and fused writes of the band's pixels.
 #[inline(always)]
 fn clear_band(s: &mut Scratch, area: BandArea) {
     let BandArea {
@@ -228,26 +264,29 @@ fn clear_band(s: &mut Scratch, area: BandArea) {
         // One call each (a loop per row was compiled into a slower inline fill).
         colour.fill([0.0; 4]);
         s.opaque[..w * rows].fill(false);
+        s.encoded[..w * rows].fill(0);
     } else {
         for r in 0..rows {
             colour[r * w + x0..r * w + x1].fill([0.0; 4]);
             s.opaque[r * w + x0..r * w + x1].fill(false);
+            s.encoded[r * w + x0..r * w + x1].fill(0);
         }
     }
 }
 
-/// Composites one layer under the band's colour. Returns how many pixels became opaque and
-/// the farthest an outline pixel's colour was taken from, or `None` when the layer reaches
-/// none of the band's pixels. `P`: see [`fill_triangles`].
+/// Composites one layer under the band's colour, writing the whole blocks it alone shows
+/// straight into `fused` when given. Returns how many pixels became opaque and the farthest an
+/// outline pixel's colour was taken from, or `None` when the layer reaches none of the band's
+/// pixels. `P`: see [`fill_triangles`].
 #[inline(always)]
 fn draw_layer<P: OutputPixel>(
     layer: &DrawableLayer,
     band: usize,
     area: BandArea,
-    opts: &RenderOptions,
-    wide: bool,
+    shading: &Shading,
     fresh: bool,
     s: &mut Scratch,
+    mut fused: Option<FusedOutput<'_, P>>,
 ) -> Option<(usize, f64)> {
     let BandArea {
         width: w,
@@ -267,7 +306,6 @@ fn draw_layer<P: OutputPixel>(
     if d0 >= d1 {
         return None;
     }
-    let shading = Shading::of_layer(layer, opts, wide);
     // Outline colours of a layer with quadratic sides are clamped as its triangles are.
     let farthest = std::cell::Cell::new(f64::NEG_INFINITY);
     let nearest = |p: [f64; 2]| {
@@ -338,13 +376,19 @@ fn draw_layer<P: OutputPixel>(
             attributes: &s.attributes,
             run: &mut s.run,
             colour,
+            fused: fused.as_mut().map(|f| FusedRow {
+                out: &mut *f.out,
+                encoded: &mut s.encoded,
+                encoding: f.encoding,
+                y: (y0 + r) as u32,
+            }),
         };
         // Separate loops for the first layer, which has nothing to test and nothing to
         // read: the tests are a noticeable share of drawing.
         opaque += if fresh {
-            shade_row::<true>(a..b, coverage, y, band, &nearest, &shading)
+            shade_row::<true, P>(a..b, coverage, y, band, &nearest, shading)
         } else {
-            shade_row::<false>(a..b, coverage, y, band, &nearest, &shading)
+            shade_row::<false, P>(a..b, coverage, y, band, &nearest, shading)
         };
     }
     Some((opaque, farthest.get()))
@@ -447,14 +491,15 @@ fn put_background_under(colour: &mut [[f32; 4]], bg: [f32; 4], area: BandArea) {
     }
 }
 
-/// Encodes the band's premultiplied colour into `out`: straight alpha, sRGB-encoded.
+/// Encodes the band's premultiplied colour into `out`: straight alpha, sRGB-encoded. Pixels
+/// `encoded` marks hold their final form already and are left alone.
 #[inline(always)]
 fn encode_band<P: OutputPixel>(
     out: &mut [P],
     colour: &[[f32; 4]],
+    encoded: &[u8],
     area: BandArea,
-    dither: bool,
-    linear: bool,
+    encoding: Encoding,
 ) {
     let BandArea {
         width: w,
@@ -463,39 +508,138 @@ fn encode_band<P: OutputPixel>(
         x1,
         ..
     } = area;
-    for (r, (row_out, row_colour)) in out
+    let rows = out
         .chunks_exact_mut(4 * w)
         .zip(colour.chunks_exact(w))
-        .enumerate()
-    {
+        .zip(encoded.chunks_exact(w));
+    for (r, ((row_out, row_colour), row_encoded)) in rows.enumerate() {
         let y = (y0 + r) as u32;
-        let (row_out, row_colour) = (&mut row_out[4 * x0..4 * x1], &row_colour[x0..x1]);
-        let pixels = row_out.chunks_exact_mut(4).zip(row_colour);
-        if dither && !linear {
-            encode_row_dithered(row_out, row_colour, x0, y);
-        } else if dither {
-            for (x, (px, c)) in (x0..).zip(pixels) {
-                let rgba = straight_srgb::<P>(c, linear);
-                let noise = output::dither_noise(x as u32, y);
-                for ch in 0..4 {
-                    px[ch] = P::encode(rgba[ch], noise[ch]);
-                }
+        let row_out = &mut row_out[4 * x0..4 * x1];
+        let (row_colour, row_encoded) = (&row_colour[x0..x1], &row_encoded[x0..x1]);
+        // The common encodings each a compilation of their own, the tests on them taken out
+        // of the loops.
+        let encoding = match encoding {
+            Encoding { linear: true, .. } => encoding,
+            Encoding { dither: true, .. } => {
+                let encoding = Encoding {
+                    dither: true,
+                    linear: false,
+                };
+                encode_row(row_out, row_colour, row_encoded, x0, y, encoding);
+                continue;
             }
-        } else if linear {
-            for (px, c) in pixels {
-                let rgba = straight_srgb::<P>(c, linear);
-                for ch in 0..4 {
-                    px[ch] = P::encode_plain(rgba[ch]);
+            Encoding { dither: false, .. } => Encoding {
+                dither: false,
+                linear: false,
+            },
+        };
+        encode_row(row_out, row_colour, row_encoded, x0, y, encoding);
+    }
+}
+
+/// Encodes a row of premultiplied colour, of row `y` from column `x0`, leaving the pixels
+/// `encoded` marks alone. Blocks of [`BLOCK`] opaque pixels (most of them) are encoded at once
+/// ([`encode_opaque_block`]), the others pixel by pixel.
+// Always inlined: see `wide_vectors`.
+#[inline(always)]
+fn encode_row<P: OutputPixel>(
+    out: &mut [P],
+    colour: &[[f32; 4]],
+    encoded: &[u8],
+    x0: usize,
+    y: u32,
+    encoding: Encoding,
+) {
+    let n = colour.len();
+    // Bounds the loops can see, so that they index without checks.
+    let (out, encoded) = (&mut out[..4 * n], &encoded[..n]);
+    let whole = n - n % BLOCK;
+    for i in (0..whole).step_by(BLOCK) {
+        let x = x0 + i;
+        let dst: &mut [P; 4 * BLOCK] = (&mut out[4 * i..4 * (i + BLOCK)])
+            .try_into()
+            .expect("a whole block");
+        let c: &[[f32; 4]; BLOCK] = colour[i..i + BLOCK].try_into().expect("a whole block");
+        let done = &encoded[i..i + BLOCK];
+        let done_flags = block_flags(done);
+        if done_flags == ALL_FLAGS {
+            continue;
+        }
+        if done_flags == 0 && all_opaque(c) {
+            encode_opaque_block(dst, c, x, y, encoding);
+        } else if done_flags != 0 && all_opaque_or_encoded(c, done) {
+            // A block the fused path wrote in part (its blocks start where a layer's row
+            // does): encoded whole, the pixels not written yet taken from it.
+            let mut whole = *dst;
+            encode_opaque_block(&mut whole, c, x, y, encoding);
+            for (i, (px, new)) in dst.iter_mut().zip(whole).enumerate() {
+                if done[i / 4] == 0 {
+                    *px = new;
                 }
             }
         } else {
-            encode_row_plain(row_out, row_colour);
+            for k in 0..BLOCK {
+                if done[k] == 0 {
+                    encode_pixel(&mut dst[4 * k..4 * k + 4], &c[k], x + k, y, encoding);
+                }
+            }
+        }
+    }
+    for i in whole..n {
+        if encoded[i] == 0 {
+            encode_pixel(&mut out[4 * i..4 * i + 4], &colour[i], x0 + i, y, encoding);
         }
     }
 }
 
-/// Pixels per block of a row that [`encode_row_plain`] and [`encode_row_dithered`] encode at
-/// once when all of them are opaque.
+/// Encodes one premultiplied colour `c`, of pixel `(x, y)`, into the four channels `px`.
+#[inline(always)]
+fn encode_pixel<P: OutputPixel>(px: &mut [P], c: &[f32; 4], x: usize, y: u32, encoding: Encoding) {
+    let rgba = straight_srgb::<P>(c, encoding.linear);
+    if encoding.dither {
+        let noise = output::dither_noise(x as u32, y);
+        for ch in 0..4 {
+            px[ch] = P::encode(rgba[ch], noise[ch]);
+        }
+    } else {
+        for ch in 0..4 {
+            px[ch] = P::encode_plain(rgba[ch]);
+        }
+    }
+}
+
+/// Encodes a block of opaque colours `c` (alpha at least 1, which encodes as 1), of the pixels
+/// of row `y` from column `x`, into `out`: what [`encode_pixel`] gives each of them, bit for
+/// bit. Without linear blending, in a loop of fixed length without branches, which
+/// vectorises; with dither, the hashes come first (64-bit, one at a time), then the noise
+/// ([`output::dither_noise_block`]) and the encoding.
+#[inline(always)]
+fn encode_opaque_block<P: OutputPixel>(
+    out: &mut [P; 4 * BLOCK],
+    c: &[[f32; 4]; BLOCK],
+    x: usize,
+    y: u32,
+    encoding: Encoding,
+) {
+    let saturated = |v: f32| if P::SATURATES { v } else { v.clamp(0.0, 1.0) };
+    if encoding.linear {
+        for (x, (px, c)) in (x..).zip(out.chunks_exact_mut(4).zip(c)) {
+            encode_pixel(px, c, x, y, encoding);
+        }
+    } else if encoding.dither {
+        let noise = output::dither_noise_block::<BLOCK, { 4 * BLOCK }>(x as u32, y);
+        for ((px, &v), &noise) in out.iter_mut().zip(c.as_flattened()).zip(&noise) {
+            *px = P::encode_branchless(saturated(v), noise);
+        }
+    } else {
+        for (px, &v) in out.iter_mut().zip(c.as_flattened()) {
+            *px = P::encode_plain(saturated(v));
+        }
+    }
+}
+
+/// Pixels per block of a row that [`encode_row`] encodes at once when all of them are opaque,
+/// and that the fused path writes at once.
 const BLOCK: usize = 8;
 
 /// Whether the pixels of `block` (premultiplied colour) are all opaque: their straight colour is
@@ -506,81 +650,13 @@ fn all_opaque(block: &[[f32; 4]; BLOCK]) -> bool {
     block.iter().fold(true, |all, c| all & (c[3] >= 1.0))
 }
 
-/// Splits a row into blocks of [`BLOCK`] pixels: calls `opaque(start, colour, out)` for each
-/// whole block whose pixels are all opaque, and `one(i, colour, out)` for every other pixel
-/// (`out`: the pixels' channels).
+/// Whether each pixel of `block` is opaque or `encoded` (its flag set).
 #[inline(always)]
-fn for_each_block<P>(
-    out: &mut [P],
-    colour: &[[f32; 4]],
-    mut opaque: impl FnMut(usize, &[[f32; 4]; BLOCK], &mut [P; 4 * BLOCK]),
-    mut one: impl FnMut(usize, &[f32; 4], &mut [P]),
-) {
-    let mut out_blocks = out.chunks_exact_mut(4 * BLOCK);
-    let mut colour_blocks = colour.chunks_exact(BLOCK);
-    for (b, (dst, c)) in out_blocks.by_ref().zip(colour_blocks.by_ref()).enumerate() {
-        let (dst, c): (&mut [P; 4 * BLOCK], &[[f32; 4]; BLOCK]) = (
-            dst.try_into().expect("a whole block"),
-            c.try_into().expect("a whole block"),
-        );
-        if all_opaque(c) {
-            opaque(b * BLOCK, c, dst);
-        } else {
-            for (k, (px, c)) in dst.chunks_exact_mut(4).zip(c).enumerate() {
-                one(b * BLOCK + k, c, px);
-            }
-        }
-    }
-    let start = colour.len() - colour_blocks.remainder().len();
-    let pixels = out_blocks.into_remainder().chunks_exact_mut(4);
-    for (k, (px, c)) in pixels.zip(colour_blocks.remainder()).enumerate() {
-        one(start + k, c, px);
-    }
-}
-
-/// Encodes a row of premultiplied sRGB-encoded colour without dither. Blocks of opaque pixels
-/// (most of them) take a loop of fixed length without branches, which vectorises; the others
-/// go pixel by pixel.
-// Always inlined: see `wide_vectors`.
-#[inline(always)]
-fn encode_row_plain<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]]) {
-    let opaque = |_: usize, c: &[[f32; 4]; BLOCK], dst: &mut [P; 4 * BLOCK]| {
-        // Alpha, at least 1, encodes as 1.
-        for (o, &v) in dst.iter_mut().zip(c.as_flattened()) {
-            *o = P::encode_plain(if P::SATURATES { v } else { v.clamp(0.0, 1.0) });
-        }
-    };
-    let one = |_: usize, c: &[f32; 4], px: &mut [P]| {
-        let rgba = straight_srgb::<P>(c, false);
-        for ch in 0..4 {
-            px[ch] = P::encode_plain(rgba[ch]);
-        }
-    };
-    for_each_block(out, colour, opaque, one);
-}
-
-/// [`encode_row_plain`] with dither noise, for the pixels of row `y` from column `x0`. In a
-/// block of opaque pixels the hashes come first (64-bit, one at a time), then the noise
-/// ([`output::dither_noise_block`]) and the encoding, which vectorise.
-// Always inlined: see `wide_vectors`.
-#[inline(always)]
-fn encode_row_dithered<P: OutputPixel>(out: &mut [P], colour: &[[f32; 4]], x0: usize, y: u32) {
-    let opaque = |start: usize, c: &[[f32; 4]; BLOCK], dst: &mut [P; 4 * BLOCK]| {
-        let noise = output::dither_noise_block::<BLOCK, { 4 * BLOCK }>((x0 + start) as u32, y);
-        // Alpha, at least 1, encodes as 1.
-        for ((px, &v), &noise) in dst.iter_mut().zip(c.as_flattened()).zip(&noise) {
-            let v = if P::SATURATES { v } else { v.clamp(0.0, 1.0) };
-            *px = P::encode_branchless(v, noise);
-        }
-    };
-    let one = |i: usize, c: &[f32; 4], px: &mut [P]| {
-        let rgba = straight_srgb::<P>(c, false);
-        let noise = output::dither_noise((x0 + i) as u32, y);
-        for ch in 0..4 {
-            px[ch] = P::encode(rgba[ch], noise[ch]);
-        }
-    };
-    for_each_block(out, colour, opaque, one);
+fn all_opaque_or_encoded(block: &[[f32; 4]; BLOCK], encoded: &[u8]) -> bool {
+    let encoded: &[u8; BLOCK] = encoded.try_into().expect("a block");
+    (0..BLOCK).fold(true, |all, i| {
+        all & ((block[i][3] >= 1.0) | (encoded[i] != 0))
+    })
 }
 
 /// How one layer's attributes become colours of the blend space.
@@ -611,7 +687,7 @@ impl Shading {
 }
 
 /// One row of a band's buffers, as a layer shades it.
-struct BandPixels<'a> {
+struct BandPixels<'a, P> {
     /// The index of the row's first pixel in the band.
     row: usize,
     opaque: &'a mut [bool],
@@ -619,6 +695,8 @@ struct BandPixels<'a> {
     attributes: &'a [[f32; 4]],
     run: &'a mut Run,
     colour: &'a mut [[f32; 4]],
+    /// Where whole blocks go straight to the output, unless they go to `colour`.
+    fused: Option<FusedRow<'a, P>>,
 }
 
 /// Composites a layer under the band's colour in columns `cols` of one row, whose coverage is
@@ -626,11 +704,11 @@ struct BandPixels<'a> {
 /// outline's (the sliver between the tessellation and the outline). `FRESH`: no layer has drawn
 /// into the band yet. Returns how many pixels became opaque.
 #[inline(always)]
-fn shade_row<const FRESH: bool>(
+fn shade_row<const FRESH: bool, P: OutputPixel>(
     cols: Range<usize>,
     coverage: &[f32],
     y: f64,
-    band: BandPixels<'_>,
+    band: BandPixels<'_, P>,
     nearest: &impl Fn([f64; 2]) -> Option<[f32; 4]>,
     shading: &Shading,
 ) -> usize {
@@ -641,6 +719,7 @@ fn shade_row<const FRESH: bool>(
         attributes,
         run,
         colour,
+        mut fused,
     } = band;
     let mut made_opaque = 0;
     // Composites pixel `k`'s colour; 1 if it became opaque. The buffers are arguments, so
@@ -700,7 +779,7 @@ fn shade_row<const FRESH: bool>(
                 // into (compositing under a clear pixel gives what a fresh layer writes).
                 // Whole, it is gathered at once; otherwise pixel by pixel, without testing
                 // a block again from each of them.
-                let under = (!FRESH).then(|| &colour[k..]);
+                let under = (!FRESH).then(|| (&colour[k..], &opaque[k..]));
                 match whole_block(&coverage[i..], &covered[k..], &attributes[k..], under) {
                     Some(at) => {
                         for (m, a) in at.iter().enumerate() {
@@ -725,7 +804,11 @@ fn shade_row<const FRESH: bool>(
             while m < n {
                 let k = run.pixel[m] as usize;
                 if run.block[m] {
-                    made_opaque += put_opaque_block(colour, opaque, k, &run.rgb[m..]);
+                    let mut rgba = [[1.0f32; 4]; BLOCK];
+                    for (dst, c) in rgba.iter_mut().zip(&run.rgb[m..m + BLOCK]) {
+                        *dst = [c[0], c[1], c[2], 1.0];
+                    }
+                    made_opaque += put_whole_block(colour, opaque, &mut fused, k - row, k, &rgba);
                     m += BLOCK;
                 } else {
                     made_opaque += put(colour, opaque, k, run.rgb[m], run.alpha[m]);
@@ -760,11 +843,11 @@ fn shade_row<const FRESH: bool>(
                     i += BLOCK;
                     continue;
                 }
-                let under = (!FRESH).then(|| &colour[k..]);
+                let under = (!FRESH).then(|| (&colour[k..], &opaque[k..]));
                 let whole = whole_block(&coverage[i..], &covered[k..], &attributes[k..], under)
                     .filter(|at| at.iter().fold(true, |all, a| all & in_unit_f32(a)));
                 if let Some(at) = whole {
-                    made_opaque += put_opaque_block(colour, opaque, k, at);
+                    made_opaque += put_whole_block(colour, opaque, &mut fused, i, k, at);
                 } else {
                     for j in i..i + BLOCK {
                         made_opaque += one(j, opaque, colour);
@@ -807,20 +890,21 @@ fn shade_row<const FRESH: bool>(
 
 /// The attributes of the first [`BLOCK`] pixels of a row if all of them are whole: covered by
 /// the outline and by triangles, opaque, and with nothing under them (the layer is the band's
-/// first, or `under`, the band's colour there, is still clear: compositing under a clear pixel
-/// gives what a first layer writes). The per-pixel loops would composite each of them with an
+/// first, or `under`, the band's colour and opaque flags there, is still clear: compositing
+/// under a clear pixel gives what a first layer writes; a pixel the fused path wrote is
+/// opaque, its colour left clear). The per-pixel loops would composite each of them with an
 /// alpha of one.
 #[inline(always)]
 fn whole_block<'a>(
     coverage: &[f32],
     covered: &[bool],
     attributes: &'a [[f32; 4]],
-    under: Option<&[[f32; 4]]>,
+    under: Option<(&[[f32; 4]], &[bool])>,
 ) -> Option<&'a [[f32; 4]; BLOCK]> {
     // `fold` with `&`: without an early exit the tests vectorise.
-    if let Some(under) = under {
+    if let Some((under, opaque)) = under {
         let under: &[[f32; 4]; BLOCK] = under[..BLOCK].try_into().expect("a block");
-        if !under.iter().fold(true, |all, c| all & (c[3] == 0.0)) {
+        if !under.iter().fold(true, |all, c| all & (c[3] == 0.0)) || any_true(opaque) {
             return None;
         }
     }
@@ -849,6 +933,57 @@ fn put_opaque_block<const C: usize>(
     }
     opaque[k..k + BLOCK].fill(true);
     BLOCK
+}
+
+/// Puts a whole block ([`whole_block`]) of colours `rgba` (alpha at least one) at the band's
+/// pixels from `k`, column `x` of the row, and marks them opaque; returns [`BLOCK`]. With
+/// `fused`, the pixels are final (the layer alone shows there): they are encoded straight
+/// into the output, as [`encode_band`] would encode them, and marked encoded; otherwise they
+/// go to the band's colour.
+#[inline(always)]
+fn put_whole_block<P: OutputPixel>(
+    colour: &mut [[f32; 4]],
+    opaque: &mut [bool],
+    fused: &mut Option<FusedRow<'_, P>>,
+    x: usize,
+    k: usize,
+    rgba: &[[f32; 4]; BLOCK],
+) -> usize {
+    let Some(f) = fused else {
+        return put_opaque_block(colour, opaque, k, rgba);
+    };
+    let out: &mut [P; 4 * BLOCK] = (&mut f.out[4 * k..4 * (k + BLOCK)])
+        .try_into()
+        .expect("a block");
+    encode_opaque_block(out, rgba, x, f.y, f.encoding);
+    #[cfg(test)]
+    FUSED_BLOCKS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    f.encoded[k..k + BLOCK].fill(1);
+    opaque[k..k + BLOCK].fill(true);
+    BLOCK
+}
+
+/// The first [`BLOCK`] flags (0 or 1) of `flags` as one word: 0 when none is set,
+/// [`ALL_FLAGS`] when all are.
+#[inline(always)]
+fn block_flags(flags: &[u8]) -> u64 {
+    u64::from_ne_bytes(flags[..BLOCK].try_into().expect("a block"))
+}
+
+/// [`block_flags`] of a block whose flags are all set.
+const ALL_FLAGS: u64 = u64::from_ne_bytes([1; BLOCK]);
+
+/// How many blocks the fused path has written, in all renders of the process: tests check that
+/// a scene takes it.
+#[cfg(test)]
+pub(super) static FUSED_BLOCKS: std::sync::atomic::AtomicUsize =
+    std::sync::atomic::AtomicUsize::new(0);
+
+/// Whether any of the first [`BLOCK`] flags of `flags` is set.
+#[inline(always)]
+fn any_true(flags: &[bool]) -> bool {
+    let block: &[bool; BLOCK] = flags[..BLOCK].try_into().expect("a block");
+    block.iter().fold(false, |any, &f| any | f)
 }
 
 /// Whether the first [`BLOCK`] flags of `flags` are all set.
@@ -915,6 +1050,15 @@ fn straight_srgb<P: OutputPixel>(c: &[f32; 4], linear: bool) -> [f32; 4] {
 mod encode_tests {
     use super::*;
 
+    const PLAIN: Encoding = Encoding {
+        dither: false,
+        linear: false,
+    };
+    const DITHERED: Encoding = Encoding {
+        dither: true,
+        linear: false,
+    };
+
     /// A row of premultiplied colours: a block of opaque pixels (one above the range), a block
     /// with clear and translucent pixels, and five after the last whole block.
     fn row() -> Vec<[f32; 4]> {
@@ -936,7 +1080,7 @@ mod encode_tests {
     fn plain_by_blocks_matches_pixels<P: OutputPixel + Default + PartialEq + std::fmt::Debug>() {
         let colour = row();
         let mut blocks = vec![P::default(); 4 * colour.len()];
-        encode_row_plain(&mut blocks, &colour);
+        encode_row(&mut blocks, &colour, &vec![0; colour.len()], 0, 0, PLAIN);
         let pixels: Vec<P> = colour
             .iter()
             .flat_map(|c| straight_srgb::<P>(c, false).map(P::encode_plain))
@@ -950,8 +1094,9 @@ mod encode_tests {
         plain_by_blocks_matches_pixels::<u8>();
         plain_by_blocks_matches_pixels::<u16>();
         let colour = row();
+        let none = vec![0; colour.len()];
         let mut f = vec![0.0f32; 4 * colour.len()];
-        encode_row_plain(&mut f, &colour);
+        encode_row(&mut f, &colour, &none, 0, 0, PLAIN);
         let expected: Vec<f32> = colour
             .iter()
             .flat_map(|c| straight_srgb::<f32>(c, false))
@@ -963,7 +1108,7 @@ mod encode_tests {
 
         let y = 7;
         let mut dithered = vec![0u8; 4 * colour.len()];
-        encode_row_dithered(&mut dithered, &colour, 0, y);
+        encode_row(&mut dithered, &colour, &none, 0, y, DITHERED);
         let expected: Vec<u8> = colour
             .iter()
             .enumerate()
@@ -976,5 +1121,54 @@ mod encode_tests {
             })
             .collect();
         assert_eq!(dithered, expected);
+    }
+
+    /// The pixels marked encoded keep what the output held, and the others are encoded as
+    /// they would be with none marked: in whole blocks, in blocks partly marked and after the
+    /// last block.
+    #[test]
+    fn rows_leave_encoded_pixels_alone() {
+        let colour = row();
+        let encoded: Vec<u8> = (0..colour.len())
+            .map(|i| u8::from(i < BLOCK || i == BLOCK + 2 || i == 2 * BLOCK + 1))
+            .collect();
+        for encoding in [PLAIN, DITHERED] {
+            let mut all = vec![0u8; 4 * colour.len()];
+            encode_row(&mut all, &colour, &vec![0; colour.len()], 3, 5, encoding);
+            let mut some = vec![77u8; 4 * colour.len()];
+            encode_row(&mut some, &colour, &encoded, 3, 5, encoding);
+            for (i, &done) in encoded.iter().enumerate() {
+                let px = &some[4 * i..4 * i + 4];
+                let expected = if done == 1 {
+                    &[77; 4][..]
+                } else {
+                    &all[4 * i..4 * i + 4]
+                };
+                assert_eq!(px, expected, "pixel {i}");
+            }
+        }
+    }
+
+    /// An opaque block whose alpha is above one encodes as the same block with an alpha of
+    /// one, for every pixel type and encoding: the fused path encodes attributes as they are.
+    #[test]
+    fn opaque_blocks_encode_alpha_above_one_as_one() {
+        fn check<P: OutputPixel + Default + PartialEq + std::fmt::Debug>() {
+            let raised: [[f32; 4]; BLOCK] = std::array::from_fn(|i| {
+                let t = i as f32 / 8.0;
+                [t, 1.0 - t, 0.3, 1.0 + t]
+            });
+            let one = raised.map(|c| [c[0], c[1], c[2], 1.0]);
+            for (dither, linear) in [(false, false), (true, false), (false, true), (true, true)] {
+                let encoding = Encoding { dither, linear };
+                let (mut a, mut b) = ([P::default(); 4 * BLOCK], [P::default(); 4 * BLOCK]);
+                encode_opaque_block(&mut a, &raised, 16, 3, encoding);
+                encode_opaque_block(&mut b, &one, 16, 3, encoding);
+                assert_eq!(a, b, "dither {dither}, linear {linear}");
+            }
+        }
+        check::<u8>();
+        check::<u16>();
+        check::<f32>();
     }
 }

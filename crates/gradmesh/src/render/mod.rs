@@ -62,6 +62,10 @@
 //!    the [`BlendSpace`] (default: sRGB-encoded, as SVG and image viewers do). The bands
 //!    composite front to back (the same sum, taken from the top layer down), so a pixel an
 //!    opaque layer already covers is not evaluated again for the layers beneath.
+//!    Blocks of eight pixels that a layer covers opaquely, with nothing of the layers above
+//!    on them, are encoded into the output as that layer is drawn (the fused path, the same
+//!    arithmetic per pixel); the other pixels are encoded from the band's colour once every
+//!    layer is in.
 //!
 //! Rows are split into bands of 16 drawn in parallel with rayon; every band does the same
 //! arithmetic whichever thread runs it, so the output does not depend on the thread count.
@@ -763,5 +767,175 @@ pub(crate) fn test_random(mut seed: u64) -> impl FnMut() -> u64 {
         seed ^= seed >> 7;
         seed ^= seed << 17;
         seed
+    }
+}
+
+#[cfg(test)]
+mod fused_drawing_tests {
+    use super::*;
+    use crate::colour::ColourSpace;
+    use kurbo::Point;
+    use std::sync::atomic::Ordering;
+
+    /// Renders `doc` into pixels of type `P`, on the fused path or the general one only.
+    fn pixels<P: OutputPixel + Default>(
+        doc: &Document,
+        opts: &RenderOptions,
+        fused: bool,
+    ) -> Vec<P> {
+        let opts = RenderOptions {
+            fused_drawing: fused,
+            ..opts.clone()
+        };
+        let mut out = vec![P::default(); 4 * (opts.width * opts.height) as usize];
+        render_document_into(doc, &opts, &mut out).unwrap();
+        out
+    }
+
+    /// Asserts that both paths draw the same bits in 8-bit, 16-bit and float pixels, and that
+    /// the fused path wrote some blocks. Lab layers take it with any options, sRGB layers only
+    /// blended in sRGB (the gamut search of the other loop has no whole blocks).
+    fn assert_same_bits(doc: &Document, opts: &RenderOptions, what: &str) {
+        let lab = doc
+            .layers
+            .iter()
+            .any(|l| l.colour_space == ColourSpace::Lab);
+        let takes_fused = lab || opts.blend == BlendSpace::Srgb;
+        let before = composite::FUSED_BLOCKS.load(Ordering::Relaxed);
+        assert!(
+            pixels::<u8>(doc, opts, true) == pixels::<u8>(doc, opts, false),
+            "8-bit, {what}"
+        );
+        assert!(
+            !takes_fused || composite::FUSED_BLOCKS.load(Ordering::Relaxed) > before,
+            "{what}: no block fused"
+        );
+        assert!(
+            pixels::<u16>(doc, opts, true) == pixels::<u16>(doc, opts, false),
+            "16-bit, {what}"
+        );
+        let (fused, general) = (
+            pixels::<f32>(doc, opts, true),
+            pixels::<f32>(doc, opts, false),
+        );
+        assert!(
+            fused
+                .iter()
+                .zip(&general)
+                .all(|(a, b)| a.to_bits() == b.to_bits()),
+            "float, {what}"
+        );
+    }
+
+    /// An sRGB grid of `n` by `n` quads over a square of side `size` from `(offset, offset)`,
+    /// its colours in range and its opacity `opacity`; bent in waves unless `straight`, when
+    /// its corners are kept and its outline is the square.
+    fn srgb_grid(n: usize, size: f64, offset: f64, opacity: f64, straight: bool) -> GradientMesh {
+        let mut mesh = GradientMesh::new(ColourSpace::Srgb);
+        for j in 0..=n {
+            for i in 0..=n {
+                let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+                let wave = if straight {
+                    0.0
+                } else {
+                    0.03 * size * (6.0 * u).sin() * (5.0 * v).cos()
+                };
+                let p = Point::new(offset + u * size + wave, offset + v * size - wave);
+                let c = mesh.add_point(p, [u, 1.0 - v, 0.5 + 0.4 * (u - v)]) as usize;
+                mesh.points[c].opacity = opacity;
+                mesh.points[c].corner = straight && (i == 0 || i == n) && (j == 0 || j == n);
+            }
+        }
+        let at = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+        for j in 0..n {
+            for i in 0..n {
+                mesh.add_face(vec![at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        mesh
+    }
+
+    fn real_layers(names: &[&str]) -> Vec<GradientMesh> {
+        let dir = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../../shared/realdata/gradientmeshimproved-off/"
+        );
+        names
+            .iter()
+            .flat_map(|name| {
+                crate::formats::read_path(&std::path::PathBuf::from(dir).join(name))
+                    .unwrap()
+                    .layers
+            })
+            .collect()
+    }
+
+    /// The fused path draws the bits of the general one: opaque layers over others (Lab's
+    /// runs, an sRGB layer's own loop), translucent layers where it must not apply, rows
+    /// partly covered and outline pixels, 8-bit with and without dither, 16-bit and float,
+    /// both blend spaces, on a background, and on one thread as on several.
+    #[test]
+    fn fused_drawing_draws_the_bits_of_the_general_path() {
+        let mut tucan = Document {
+            layers: real_layers(&[
+                "Tucan_Tucan_Layer5.off",
+                "Tucan_Tucan_Layer4.off",
+                "Tucan_Tucan_Layer2.off",
+                "Tucan_Tucan_Layer0.off",
+            ]),
+        };
+        // A translucent layer on top, and the bottom one in sRGB with its colours in range.
+        let top = tucan.layers.len() - 1;
+        for (i, p) in tucan.layers[top].points.iter_mut().enumerate() {
+            p.opacity = if i % 3 == 0 { 0.6 } else { 1.0 };
+        }
+        let bottom = &mut tucan.layers[0];
+        for p in &mut bottom.points {
+            let c = bottom.colour_space.convert(ColourSpace::Srgb, p.colour);
+            p.colour = c.map(|v| v.clamp(0.0, 1.0));
+        }
+        for w in &mut bottom.wedges {
+            let c = bottom.colour_space.convert(ColourSpace::Srgb, w.colour);
+            w.colour = c.map(|v| v.clamp(0.0, 1.0));
+        }
+        bottom.colour_space = ColourSpace::Srgb;
+        // An opaque sRGB grid under a translucent one that covers part of it.
+        let grids = Document {
+            layers: vec![
+                srgb_grid(6, 180.0, 10.0, 1.0, false),
+                srgb_grid(3, 90.0, 60.0, 0.5, false),
+            ],
+        };
+        // An opaque square whose sides run along pixel edges over another layer: pixels it
+        // fuses lie right beside clear ones, in blocks the layer beneath must not take whole.
+        let square = Document {
+            layers: vec![
+                srgb_grid(5, 200.0, 0.0, 1.0, false),
+                srgb_grid(4, 64.0, 37.0, 1.0, true),
+            ],
+        };
+        let mut opts = RenderOptions::new(200, 200, View::new(0.0, 0.0, 200.0, 200.0));
+        opts.dither = false;
+        assert_same_bits(&square, &opts, "a square along pixel edges");
+        for (doc, name) in [(&tucan, "Tucan"), (&grids, "grids")] {
+            let mut opts = RenderOptions::fit(doc, 203);
+            assert_same_bits(doc, &opts, &format!("{name}, dithered"));
+            opts.dither = false;
+            assert_same_bits(doc, &opts, name);
+            opts.blend = BlendSpace::Linear;
+            assert_same_bits(doc, &opts, &format!("{name}, linear blending"));
+            opts.background = Some([1.0, 0.9, 0.8, 0.7]);
+            opts.dither = true;
+            assert_same_bits(doc, &opts, &format!("{name}, on a background"));
+            let one_thread = rayon::ThreadPoolBuilder::new()
+                .num_threads(1)
+                .build()
+                .unwrap()
+                .install(|| pixels::<u8>(doc, &opts, true));
+            assert!(
+                one_thread == pixels::<u8>(doc, &opts, true),
+                "{name}, one thread"
+            );
+        }
     }
 }

@@ -70,6 +70,12 @@ pub struct RenderOptions {
     /// that passes the colour tolerance with fewer cells than linear colour (default `true`).
     /// `false` draws every face with linear colour (more triangles), for comparison.
     pub quadratic: bool,
+    /// Whether blocks of pixels that one layer covers opaquely, with nothing of the layers
+    /// above on them, are encoded straight into the output as that layer is drawn, past the
+    /// band's colour buffer (default `true`). The pixels are the same either way; `false`
+    /// takes every pixel through the buffer, so that tests can compare the two paths.
+    #[doc(hidden)]
+    pub fused_drawing: bool,
 }
 
 impl Default for RenderOptions {
@@ -92,6 +98,7 @@ impl Default for RenderOptions {
             dither: true,
             max_pixels: MAX_PIXELS,
             quadratic: true,
+            fused_drawing: true,
         }
     }
 }
