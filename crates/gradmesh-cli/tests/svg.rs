@@ -374,3 +374,109 @@ fn svg_whole_picture_keeps_paint_order() {
         assert_eq!(at(90, 10), empty, "nothing painted");
     }
 }
+
+/// gradmesh's own SVG export read back: Paprika's three layers exported as thousands of
+/// mesh-filled shapes (one patch each), with and without the PNG fallback beneath, render like
+/// the PNG of the same layers: the same pixels covered, colours within a level or so, and no
+/// fallback to drawing the meshes alone.
+#[test]
+fn exported_svg_reads_back_as_the_png_of_its_layers() {
+    let dir = tempfile::tempdir().unwrap();
+    let off = PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/realdata/gradientmeshimproved-off"
+    ));
+    let layers: Vec<String> = (0..3)
+        .map(|k| {
+            let p = off.join(format!("Paprika_Paprika_layer{k}.off"));
+            assert!(
+                p.exists(),
+                "{} is missing from ../shared/realdata",
+                p.display()
+            );
+            p.to_str().unwrap().to_owned()
+        })
+        .collect();
+    let png = dir.path().join("direct.png");
+    let mut args: Vec<&str> = vec!["render"];
+    args.extend(layers.iter().map(String::as_str));
+    let render_to = |out: &std::path::Path, extra: &[&str]| {
+        let mut a = args.clone();
+        a.extend(["-o", out.to_str().unwrap(), "--width", "256"]);
+        a.extend(extra);
+        let o = gradmesh(&a);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    render_to(&png, &[]);
+    let (w, h, direct) = decode_png(&png);
+    for extra in [&[][..], &["--no-fallback"][..]] {
+        let svg = dir.path().join("exported.svg");
+        render_to(&svg, extra);
+        let text = std::fs::read_to_string(&svg).unwrap();
+        let fills = text.matches("<meshgradient").count();
+        assert!(fills > 1000, "{fills} mesh gradients");
+        let back = dir.path().join("back.png");
+        let o = gradmesh(&[
+            "render",
+            svg.to_str().unwrap(),
+            "-o",
+            back.to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{stderr}");
+        assert!(!stderr.contains("only the mesh fills"), "{stderr}");
+        let (bw, bh, read_back) = decode_png(&back);
+        assert_eq!((bw, bh), (w, h));
+        let (mut both, mut differ, mut sum) = (0usize, 0usize, 0.0f64);
+        for (a, b) in direct.chunks_exact(4).zip(read_back.chunks_exact(4)) {
+            if (a[3] > 0) != (b[3] > 0) {
+                differ += 1;
+            }
+            if a[3] == 255 && b[3] == 255 {
+                both += 1;
+                sum += (0..3)
+                    .map(|c| (a[c] as f64 - b[c] as f64).abs())
+                    .sum::<f64>()
+                    / 3.0;
+            }
+        }
+        let mean = sum / both as f64;
+        assert!(both > 10_000, "{both} opaque pixels in both");
+        assert!(differ * 100 < both, "{differ} pixels covered by one only");
+        assert!(mean < 1.5, "mean difference {mean} levels ({extra:?})");
+    }
+}
+
+/// A file whose mesh fills alternate with other content by the thousand: each part between
+/// them would be a copy of the file for resvg to parse, so above the limit only the mesh fills
+/// are drawn, with a warning that says why.
+#[test]
+fn too_many_parts_between_mesh_fills_draw_the_meshes_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::from(
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="64" height="64" viewBox="0 0 64 64">"#,
+    );
+    for k in 0..3000 {
+        let x = (k % 60) as f64;
+        text.push_str(&format!(
+            r##"<meshgradient id="m{k}" x="{x}" y="0"><meshrow><meshpatch><stop path="c 1,0 2,0 4,0" stop-color="#ff0000"/><stop path="c 0,1 0,2 0,4" stop-color="#00ff00"/><stop path="c -1,0 -2,0 -4,0" stop-color="#0000ff"/><stop path="c 0,-1 0,-2 0,-4" stop-color="#ffff00"/></meshpatch></meshrow></meshgradient><rect x="{x}" y="0" width="4" height="4" fill="url(#m{k})"/><rect x="{x}" y="10" width="4" height="4" fill="#000000"/>"##
+        ));
+    }
+    text.push_str("</svg>");
+    let svg = dir.path().join("many.svg");
+    std::fs::write(&svg, &text).unwrap();
+    let png = dir.path().join("many.png");
+    let o = gradmesh(&["render", svg.to_str().unwrap(), "-o", png.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("only the mesh fills are drawn: 3000 parts of other content"),
+        "{stderr}"
+    );
+    let (w, h, pixels) = decode_png(&png);
+    assert_eq!((w, h), (64, 64));
+    assert!(
+        pixels.chunks_exact(4).any(|p| p[3] == 255),
+        "the meshes are drawn"
+    );
+}

@@ -7,7 +7,12 @@
 //! has `display:none`, and whose root shows the render's view at the render's size. A mesh
 //! shape's stroke is drawn at the start of the segment above its fill (its fill set to `none`).
 //! Segments and mesh layers are composited source-over with premultiplied alpha, in `f32`, on
-//! sRGB-encoded values (as resvg and Inkscape blend).
+//! sRGB-encoded values (as resvg and Inkscape blend). A segment that draws nothing (no element
+//! but mesh shapes, and no stroke on the mesh shape it starts at) is not rendered, and the mesh
+//! layers it separates are rendered together: a file of thousands of mesh-filled shapes and
+//! nothing else (gradmesh's own SVG export) costs one mesh render. Each segment that draws is
+//! a copy of the file parsed by resvg; above [`MAX_SEGMENT_TEXT`] bytes of such copies only
+//! the mesh fills are drawn, with a warning.
 //!
 //! Limits: a group's `opacity`, `filter`, `mask` or `clip-path` is applied to each segment's
 //! part of the group separately, not to the group as a whole, when a mesh fill splits it.
@@ -177,64 +182,110 @@ fn apply(text: &str, mut edits: Vec<Edit>) -> String {
     out
 }
 
-/// The texts of the segments of `text` (`fills + 1` of them, bottom first), each showing
-/// `opts.view` at the render's size. An error message when the file's mesh-filled shapes are
-/// not the `fills` that gradmesh read.
-fn segment_texts(text: &str, fills: usize, opts: &RenderOptions) -> Result<Vec<String>, String> {
-    let doc = Document::parse_with_options(
-        text,
-        roxmltree::ParsingOptions {
-            allow_dtd: true,
-            ..Default::default()
-        },
-    )
-    .map_err(|e| e.to_string())?;
-    let mesh_ids = doc
-        .descendants()
-        .filter(|n| n.tag_name().name().eq_ignore_ascii_case("meshgradient"))
-        .filter_map(|n| n.attribute("id"))
-        .collect();
-    let mut drawn = DrawnElements {
-        mesh_ids,
-        elements: Vec::new(),
-        mesh_shapes: Vec::new(),
-    };
-    collect(doc.root_element(), &mut drawn);
-    if drawn.mesh_shapes.len() != fills {
-        return Err(format!(
-            "{} shapes name a mesh gradient as fill, but {fills} mesh fills were read",
-            drawn.mesh_shapes.len()
-        ));
+/// The most text resvg is given to parse for one picture, summed over its segments (each
+/// segment is a whole copy of the file): beyond it only the mesh fills are drawn.
+const MAX_SEGMENT_TEXT: usize = 1 << 30;
+
+/// A document split at its mesh-filled shapes into segments (`fills + 1` of them, bottom
+/// first): segment `s` runs from mesh shape `s - 1` (its stroke only) to below mesh shape `s`.
+struct Segments<'a, 'input> {
+    text: &'input str,
+    drawn: DrawnElements<'a, 'input>,
+    /// Whether each drawn element is a mesh-filled shape.
+    is_mesh_shape: Vec<bool>,
+    /// Whether each segment draws anything: an element other than a mesh shape, or the stroke
+    /// of the mesh shape it starts at.
+    drawing: Vec<bool>,
+    /// The root's edits that show the render's view at its size.
+    root: Vec<Edit>,
+}
+
+/// Whether `node` may be stroked: its own or an inherited `stroke` other than `none`, or any
+/// style sheet in the document (whose rules are not read here).
+fn may_have_stroke(node: Node, style_sheets: bool) -> bool {
+    style_sheets
+        || node
+            .ancestors()
+            .find_map(|n| own_property(n, "stroke"))
+            .is_some_and(|stroke| stroke != "none")
+}
+
+impl<'a, 'input> Segments<'a, 'input> {
+    /// An error message when the file's mesh-filled shapes are not the `fills` that gradmesh
+    /// read.
+    fn new(
+        doc: &'a Document<'input>,
+        text: &'input str,
+        fills: usize,
+        opts: &RenderOptions,
+    ) -> Result<Self, String> {
+        let mesh_ids = doc
+            .descendants()
+            .filter(|n| n.tag_name().name().eq_ignore_ascii_case("meshgradient"))
+            .filter_map(|n| n.attribute("id"))
+            .collect();
+        let mut drawn = DrawnElements {
+            mesh_ids,
+            elements: Vec::new(),
+            mesh_shapes: Vec::new(),
+        };
+        collect(doc.root_element(), &mut drawn);
+        if drawn.mesh_shapes.len() != fills {
+            return Err(format!(
+                "{} shapes name a mesh gradient as fill, but {fills} mesh fills were read",
+                drawn.mesh_shapes.len()
+            ));
+        }
+        let mut is_mesh_shape = vec![false; drawn.elements.len()];
+        for &i in &drawn.mesh_shapes {
+            is_mesh_shape[i] = true;
+        }
+        let style_sheets = doc
+            .descendants()
+            .any(|n| is_svg(n) && n.tag_name().name() == "style");
+        let mut drawing = vec![false; fills + 1];
+        let mut segment = 0;
+        for (i, node) in drawn.elements.iter().enumerate() {
+            if is_mesh_shape[i] {
+                segment += 1;
+                drawing[segment] |= may_have_stroke(*node, style_sheets);
+            } else {
+                drawing[segment] = true;
+            }
+        }
+        let root = root_view(doc.root_element(), text, opts);
+        Ok(Segments {
+            text,
+            drawn,
+            is_mesh_shape,
+            drawing,
+            root,
+        })
     }
-    let root = root_view(doc.root_element(), text, opts);
-    let bounds: Vec<usize> = drawn
-        .mesh_shapes
-        .iter()
-        .copied()
-        .chain([usize::MAX])
-        .collect();
-    let mut texts = Vec::with_capacity(fills + 1);
-    for (s, &end) in bounds.iter().enumerate() {
-        // Segment `s` runs from mesh shape `s - 1` (its stroke only) to below mesh shape `s`.
-        let start = if s == 0 { None } else { Some(bounds[s - 1]) };
-        let mut edits: Vec<Edit> = root
+
+    /// The text of segment `s`, showing the render's view at its size.
+    fn text(&self, s: usize) -> String {
+        let bounds = &self.drawn.mesh_shapes;
+        let start = s.checked_sub(1).map(|k| bounds[k]);
+        let end = bounds.get(s).copied().unwrap_or(usize::MAX);
+        let mut edits: Vec<Edit> = self
+            .root
             .iter()
             .map(|e| Edit {
                 range: e.range.clone(),
                 with: e.with.clone(),
             })
             .collect();
-        for (i, node) in drawn.elements.iter().enumerate() {
+        for (i, node) in self.drawn.elements.iter().enumerate() {
             let inside = start.is_none_or(|b| i >= b) && i < end;
             if Some(i) == start {
-                edits.push(add_style(*node, text, "fill:none"));
-            } else if !inside || drawn.mesh_shapes.contains(&i) {
-                edits.push(add_style(*node, text, "display:none"));
+                edits.push(add_style(*node, self.text, "fill:none"));
+            } else if !inside || self.is_mesh_shape[i] {
+                edits.push(add_style(*node, self.text, "display:none"));
             }
         }
-        texts.push(apply(text, edits));
+        apply(self.text, edits)
     }
-    Ok(texts)
 }
 
 /// Renders one segment's text with resvg into a premultiplied RGBA8 pixmap.
@@ -327,41 +378,60 @@ pub fn render_whole_picture(
     mesh_layers: &[PictureLayer<'_>],
     opts: &RenderOptions,
 ) -> Result<Result<(Image, render::RenderInfo), String>, Error> {
-    let segments = match segment_texts(text, mesh_layers.len(), opts) {
+    let doc = match Document::parse_with_options(
+        text,
+        roxmltree::ParsingOptions {
+            allow_dtd: true,
+            ..Default::default()
+        },
+    ) {
+        Ok(doc) => doc,
+        Err(e) => return Ok(Err(e.to_string())),
+    };
+    let segments = match Segments::new(&doc, text, mesh_layers.len(), opts) {
         Ok(s) => s,
         Err(message) => return Ok(Err(message)),
     };
-    let options = resvg_options();
-    let mut acc = vec![0.0f32; 4 * opts.width as usize * opts.height as usize];
-    if let Some(bg) = opts.background {
-        let alpha = bg[3].clamp(0.0, 1.0) as f32;
-        for px in acc.chunks_exact_mut(4) {
-            for c in 0..3 {
-                px[c] = bg[c].clamp(0.0, 1.0) as f32 * alpha;
-            }
-            px[3] = alpha;
-        }
+    let drawing = segments.drawing.iter().filter(|&&d| d).count();
+    if drawing.saturating_mul(text.len()) > MAX_SEGMENT_TEXT {
+        return Ok(Err(format!(
+            "{drawing} parts of other content lie between its mesh fills, each drawn from a \
+             copy of the file: over the limit of {MAX_SEGMENT_TEXT} bytes in all"
+        )));
     }
+    let options = resvg_options();
+    let mut acc = background_canvas(opts);
     let mut layer_opts = opts.clone();
     layer_opts.background = None;
     let mut info = render::RenderInfo::default();
     let mut layer = Image::new(opts.width, opts.height);
-    for (s, segment) in segments.iter().enumerate() {
-        match render_segment(segment, &options, opts) {
-            Ok(pixmap) => composite_pixmap(&mut acc, &pixmap),
-            Err(message) => return Ok(Err(message)),
-        }
-        if let Some(mesh) = mesh_layers.get(s) {
+    // Mesh layers with nothing drawn between them are rendered together: the first of the
+    // run not yet drawn.
+    let mut run_start = 0;
+    let mut draw_meshes = |end: usize, acc: &mut [f32], start: &mut usize| {
+        if *start < end {
             layer.data.fill(0.0);
             let drawn = render::render_picture_into(
-                std::slice::from_ref(mesh),
+                &mesh_layers[*start..end],
                 &layer_opts,
                 &mut layer.data,
             )?;
-            merge_info(&mut info, drawn, s);
-            composite_image(&mut acc, &layer.data);
+            merge_info(&mut info, drawn, *start);
+            composite_image(acc, &layer.data);
+        }
+        *start = end;
+        Ok::<(), Error>(())
+    };
+    for s in 0..=mesh_layers.len() {
+        if segments.drawing[s] {
+            draw_meshes(s, &mut acc, &mut run_start)?;
+            match render_segment(&segments.text(s), &options, opts) {
+                Ok(pixmap) => composite_pixmap(&mut acc, &pixmap),
+                Err(message) => return Ok(Err(message)),
+            }
         }
     }
+    draw_meshes(mesh_layers.len(), &mut acc, &mut run_start)?;
     for px in acc.chunks_exact_mut(4) {
         if px[3] > 0.0 {
             for c in 0..3 {
@@ -377,14 +447,30 @@ pub fn render_whole_picture(
     Ok(Ok((image, info)))
 }
 
-/// Adds the report of one mesh layer's render (layer `index` of the picture) to `info`.
-fn merge_info(info: &mut render::RenderInfo, drawn: render::RenderInfo, index: usize) {
+/// A premultiplied canvas of the render's size filled with `opts.background` (or clear).
+fn background_canvas(opts: &RenderOptions) -> Vec<f32> {
+    let mut acc = vec![0.0f32; 4 * opts.width as usize * opts.height as usize];
+    if let Some(bg) = opts.background {
+        let alpha = bg[3].clamp(0.0, 1.0) as f32;
+        for px in acc.chunks_exact_mut(4) {
+            for c in 0..3 {
+                px[c] = bg[c].clamp(0.0, 1.0) as f32 * alpha;
+            }
+            px[3] = alpha;
+        }
+    }
+    acc
+}
+
+/// Adds the report of a render of mesh layers, the first of which is layer `first` of the
+/// picture, to `info`.
+fn merge_info(info: &mut render::RenderInfo, drawn: render::RenderInfo, first: usize) {
     info.timings.prepare += drawn.timings.prepare;
     info.timings.draw += drawn.timings.draw;
     info.layers.extend(drawn.layers);
     info.warnings
         .extend(drawn.warnings.into_iter().map(|mut w| {
-            w.layer = w.layer.map(|_| index);
+            w.layer = w.layer.map(|l| first + l);
             w
         }));
 }
