@@ -211,8 +211,8 @@ fn may_have_stroke(node: Node, style_sheets: bool) -> bool {
 }
 
 impl<'a, 'input> Segments<'a, 'input> {
-    /// An error message when the file's mesh-filled shapes are not the `fills` that gradmesh
-    /// read.
+    /// Splits `doc` (parsed from `text`) and finds which segments draw; an error message when
+    /// the file's mesh-filled shapes are not the `fills` that gradmesh read.
     fn new(
         doc: &'a Document<'input>,
         text: &'input str,
@@ -405,33 +405,33 @@ pub fn render_whole_picture(
     layer_opts.background = None;
     let mut info = render::RenderInfo::default();
     let mut layer = Image::new(opts.width, opts.height);
-    // Mesh layers with nothing drawn between them are rendered together: the first of the
-    // run not yet drawn.
+    // Mesh layers with nothing drawn between them are rendered together, in one call: the
+    // layers from `run_start` wait until the next segment that draws, or the end.
     let mut run_start = 0;
-    let mut draw_meshes = |end: usize, acc: &mut [f32], start: &mut usize| {
-        if *start < end {
+    let mut draw_meshes_below = |end: usize, acc: &mut [f32]| {
+        if run_start < end {
             layer.data.fill(0.0);
             let drawn = render::render_picture_into(
-                &mesh_layers[*start..end],
+                &mesh_layers[run_start..end],
                 &layer_opts,
                 &mut layer.data,
             )?;
-            merge_info(&mut info, drawn, *start);
+            merge_info(&mut info, drawn, run_start);
             composite_image(acc, &layer.data);
+            run_start = end;
         }
-        *start = end;
         Ok::<(), Error>(())
     };
     for s in 0..=mesh_layers.len() {
         if segments.drawing[s] {
-            draw_meshes(s, &mut acc, &mut run_start)?;
+            draw_meshes_below(s, &mut acc)?;
             match render_segment(&segments.text(s), &options, opts) {
                 Ok(pixmap) => composite_pixmap(&mut acc, &pixmap),
                 Err(message) => return Ok(Err(message)),
             }
         }
     }
-    draw_meshes(mesh_layers.len(), &mut acc, &mut run_start)?;
+    draw_meshes_below(mesh_layers.len(), &mut acc)?;
     for px in acc.chunks_exact_mut(4) {
         if px[3] > 0.0 {
             for c in 0..3 {
