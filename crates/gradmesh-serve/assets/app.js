@@ -85,6 +85,8 @@ function receiveText(message) {
   if (message.type === "done") {
     editor.busy = false;
     flush();
+  } else if (message.type === "error" && answerRefusal(message)) {
+    // files.js asked the user.
   } else if (message.type === "error" || message.type === "notice") {
     showMessage(message.message);
   } else if (message.type === "state") {
@@ -597,16 +599,6 @@ window.addEventListener("keydown", (event) => {
 
 // ---- actions ------------------------------------------------------------------------------
 
-function save() {
-  if (editor.state && editor.state.file) send({ type: "save" }); else saveAs();
-}
-
-function saveAs() {
-  const name = prompt("Save as (a .json name in the starting folder):",
-    (editor.state && editor.state.file) || "untitled.json");
-  if (name) send({ type: "save_as", name });
-}
-
 function deleteSelection() {
   if (editor.selection.length > 0) {
     edit({ op: "delete_points", layer: editor.activeLayer, points: editor.selection });
@@ -696,8 +688,6 @@ $("delete").onclick = deleteSelection;
 $("undo").onclick = () => send({ type: "undo" });
 $("redo").onclick = () => send({ type: "redo" });
 $("fit").onclick = fitView;
-$("save").onclick = save;
-$("save-as").onclick = saveAs;
 $("new").onclick = () => {
   if (editor.state && editor.state.modified && !confirm("Discard the changes not saved?")) return;
   editor.state = null; editor.selection = []; send({ type: "new" });
@@ -817,8 +807,7 @@ async function refreshFiles() {
 function updatePanels() {
   const state = editor.state;
   if (!state) return;
-  $("file-name").textContent = state.file || "new document (not saved)";
-  $("file-name").classList.toggle("modified", state.modified);
+  showFileState(state);
   $("undo").disabled = !state.can_undo;
   $("redo").disabled = !state.can_redo;
   updateLayerList(state);

@@ -10,7 +10,7 @@
 #![allow(missing_docs)] // criterion_group! generates undocumented items.
 
 use std::path::Path;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, Criterion};
@@ -66,13 +66,11 @@ fn tucan_session() -> (Session, usize, usize) {
     let height = (WIDTH as f64 * bounds.height() / bounds.width()).round() as u32;
     let (layer, point) = costliest_point(&doc, &RenderOptions::new(WIDTH, height, bounds));
     let folder = Folder::new(&std::env::temp_dir()).expect("temp folder");
-    let app = Arc::new(App {
-        editor: Mutex::new(Editor {
-            history: History::new(Picture::new(doc)),
-            path: None,
-        }),
-        folder,
-    });
+    let editor = Editor {
+        history: History::new(Picture::new(doc)),
+        path: None,
+    };
+    let app = Arc::new(App::new(editor, folder));
     let mut session = Session::new(app);
     let view = format!(
         r#"{{"type":"view","width":{WIDTH},"height":{height},"view":[{},{},{},{}]}}"#,

@@ -11,6 +11,7 @@
 //! and writes documents only inside the starting folder, and saves atomically.
 
 pub mod editor;
+pub mod files;
 pub mod ops;
 pub mod refined;
 pub mod security;
@@ -21,7 +22,7 @@ pub mod viewer;
 
 use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 pub use editor::{Editor, History};
 pub use ops::{Op, Picture};
@@ -73,7 +74,7 @@ pub fn open_app(config: &Config) -> Result<Arc<App>, String> {
     };
     let folder = Folder::new(&folder_path)
         .map_err(|e| format!("cannot use the folder {}: {e}", folder_path.display()))?;
-    let editor = match &config.file {
+    let (editor, source) = match &config.file {
         Some(file) => {
             let mut editor = Editor::open(file)?;
             // "save" writes inside the folder only.
@@ -81,14 +82,15 @@ pub fn open_app(config: &Config) -> Result<Arc<App>, String> {
                 let name = path.file_name().map(|n| n.to_string_lossy().to_string());
                 editor.path = name.and_then(|n| folder.resolve(&n).ok());
             }
-            editor
+            let source = file.canonicalize().ok();
+            (editor, source)
         }
-        None => Editor::new_document(),
+        None => (Editor::new_document(), None),
     };
-    Ok(Arc::new(App {
-        editor: Mutex::new(editor),
-        folder,
-    }))
+    let app = App::new(editor, folder);
+    app.files()
+        .opened(source.as_deref(), &app.editor.lock().expect("a new lock"));
+    Ok(Arc::new(app))
 }
 
 /// Starts serving `config` on 127.0.0.1 in the current tokio runtime.

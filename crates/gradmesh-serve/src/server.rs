@@ -26,6 +26,7 @@ pub const PNG_SIDE: u32 = 2048;
 
 const INDEX_HTML: &str = include_str!("../assets/index.html");
 const APP_JS: &str = include_str!("../assets/app.js");
+const FILES_JS: &str = include_str!("../assets/files.js");
 const STYLE_CSS: &str = include_str!("../assets/style.css");
 
 /// The routes, each behind the gate.
@@ -36,6 +37,10 @@ pub fn router(app: Arc<App>, gate: Gate) -> Router {
         .route(
             "/app.js",
             get(|| asset(APP_JS, "text/javascript; charset=utf-8")),
+        )
+        .route(
+            "/files.js",
+            get(|| asset(FILES_JS, "text/javascript; charset=utf-8")),
         )
         .route(
             "/style.css",
@@ -111,7 +116,7 @@ fn reply(messages: Vec<Outgoing>) -> Response {
         match message {
             Outgoing::Error(text) => {
                 return (
-                    StatusCode::UNPROCESSABLE_ENTITY,
+                    crate::files::status_of_error(&text),
                     [(header::CONTENT_TYPE, "application/json")],
                     text,
                 )

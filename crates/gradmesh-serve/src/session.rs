@@ -7,6 +7,7 @@ use gradmesh::render::View;
 use serde::Deserialize;
 
 use crate::editor::Editor;
+use crate::files::{self, FileState, Refusal};
 use crate::ops::Op;
 use crate::security::Folder;
 use crate::state::{FoldCache, Status};
@@ -19,9 +20,25 @@ pub struct App {
     pub editor: Mutex<Editor>,
     /// The starting folder.
     pub folder: Folder,
+    /// What the session wrote and saved ([`files`]).
+    pub files: Mutex<FileState>,
 }
 
 impl App {
+    /// The app editing `editor`'s document in `folder`.
+    pub fn new(editor: Editor, folder: Folder) -> App {
+        App {
+            editor: Mutex::new(editor),
+            folder,
+            files: Mutex::new(FileState::default()),
+        }
+    }
+
+    /// What the session wrote and saved (locked after [`App::editor`] when both are held).
+    pub fn files(&self) -> MutexGuard<'_, FileState> {
+        self.files.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
     /// The editor, even if a thread panicked while holding it (its data is whole: every edit
     /// replaces the picture in one assignment).
     pub fn editor(&self) -> MutexGuard<'_, Editor> {
@@ -59,11 +76,18 @@ pub enum Command {
         view: [f64; 4],
     },
     /// Saves to the document's file.
-    Save,
+    Save {
+        /// Replace the file even if this session did not write it.
+        #[serde(default)]
+        overwrite: bool,
+    },
     /// Saves to another JSON file in the starting folder.
     SaveAs {
         /// Its name relative to the folder.
         name: String,
+        /// Replace the file even if this session did not write it.
+        #[serde(default)]
+        overwrite: bool,
     },
     /// Opens a document of the starting folder.
     Open {
@@ -93,8 +117,9 @@ pub enum Outgoing {
 pub struct Session {
     app: Arc<App>,
     viewer: Viewer,
-    /// The history version the page last got the state of, and whether a gesture was open.
-    told_version: Option<(u64, bool)>,
+    /// The history version the page last got the state of, whether a gesture was open, and
+    /// the generation of the file state.
+    told_version: Option<(u64, bool, u64)>,
     folds: FoldCache,
 }
 
@@ -139,7 +164,7 @@ impl Session {
                     serde_json::json!({"type": "notice", "message": note}).to_string(),
                 )),
                 Ok(None) => {}
-                Err(message) => out.push(error_message(&message)),
+                Err(refusal) => out.push(Outgoing::Error(refusal.to_json())),
             }
         }
         let doc = self.app.editor().history.current().visible();
@@ -161,7 +186,8 @@ impl Session {
         let app = Arc::clone(&self.app);
         let editor = app.editor();
         let h = &editor.history;
-        let key = (h.version(), h.gesture_open());
+        let files = app.files();
+        let key = (h.version(), h.gesture_open(), files.generation());
         if self.told_version == Some(key) {
             return None;
         }
@@ -176,11 +202,13 @@ impl Session {
             folds,
         };
         self.told_version = Some(key);
-        Some(status.to_json().to_string())
+        let mut state = status.to_json();
+        files::describe(&files, &mut state);
+        Some(state.to_string())
     }
 
     /// Runs one command; returns the edit's note for the user, if any.
-    fn run(&mut self, command: &Command) -> Result<Option<String>, String> {
+    fn run(&mut self, command: &Command) -> Result<Option<String>, Refusal> {
         let app = Arc::clone(&self.app);
         let mut editor = app.editor();
         let mut note = None;
@@ -213,27 +241,37 @@ impl Session {
                     view: View::new(x0, y0, x1, y1),
                 })
             }
-            Command::Save => match editor.path.clone() {
-                Some(path) => editor.save_to(&path),
-                None => Err("this document has no file yet: use Save as".into()),
-            },
-            Command::SaveAs { name } => {
+            Command::Save { overwrite } => {
+                let Some(path) = editor.path.clone() else {
+                    return Err("this document has no file yet: use Save as"
+                        .to_string()
+                        .into());
+                };
+                let mut files = app.files();
+                return files::save(&app.folder, &mut files, &mut editor, &path, *overwrite)
+                    .map(|()| None);
+            }
+            Command::SaveAs { name, overwrite } => {
                 let path = app.folder.resolve(name)?;
-                editor.save_to(&path)
+                let mut files = app.files();
+                return files::save(&app.folder, &mut files, &mut editor, &path, *overwrite)
+                    .map(|()| None);
             }
             Command::Open { name } => {
                 let path = app.folder.resolve(name)?;
                 *editor = Editor::open(&path)?;
+                app.files().opened(Some(&path), &editor);
                 self.told_version = None;
                 Ok(())
             }
             Command::New => {
                 *editor = Editor::new_document();
+                app.files().opened(None, &editor);
                 self.told_version = None;
                 Ok(())
             }
         };
-        done.map(|()| note)
+        done.map(|()| note).map_err(Refusal::from)
     }
 }
 
@@ -257,13 +295,11 @@ mod tests {
         }
         .apply(&mut picture)
         .unwrap();
-        let app = App {
-            editor: Mutex::new(Editor {
-                history: History::new(picture),
-                path: None,
-            }),
-            folder: Folder::new(&std::env::temp_dir()).unwrap(),
+        let editor = Editor {
+            history: History::new(picture),
+            path: None,
         };
+        let app = App::new(editor, Folder::new(&std::env::temp_dir()).unwrap());
         Session::new(Arc::new(app))
     }
 

@@ -1,0 +1,182 @@
+//! Saving through the API: the state the page is told after a save, and the refusal (409,
+//! `code: "file_exists"`) to replace a file the session did not write unless the request says
+//! `overwrite: true`.
+
+use std::path::{Path, PathBuf};
+
+use gradmesh_serve::{start, Config, Running};
+use serde_json::Value;
+use tokio::io::{AsyncReadExt, AsyncWriteExt};
+use tokio::net::TcpStream;
+
+const SQUARE: &str = r##"{"format":"gradmesh","version":1,"layers":[{"name":"square","points":[
+  {"position":[0,0],"colour":"#d04020"},{"position":[100,0],"colour":"#e0c030"},
+  {"position":[100,100],"colour":"#2060c0"},{"position":[0,100],"colour":"#40a040"}],
+  "faces":[[0,1,2,3]]}]}"##;
+
+/// A file of the paper authors' artwork in `../shared`, or a clear failure.
+fn shared_off(name: &str) -> PathBuf {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/realdata/gradientmeshimproved-off")
+        .join(name);
+    assert!(
+        path.is_file(),
+        "the test needs {} (the shared data beside the repository)",
+        path.display()
+    );
+    path
+}
+
+async fn serve(file: Option<PathBuf>, folder: &Path) -> Running {
+    start(&Config {
+        file,
+        folder: Some(folder.to_path_buf()),
+        ..Config::default()
+    })
+    .await
+    .unwrap()
+}
+
+/// POSTs a command; the status and the answer's JSON.
+async fn command(running: &Running, json: &str) -> (u16, Value) {
+    let mut stream = TcpStream::connect(running.address).await.unwrap();
+    let head = format!(
+        "POST /api/command?token={} HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nConnection: close\r\n\
+         Content-Type: application/json\r\nContent-Length: {}\r\n\r\n",
+        running.token,
+        running.address.port(),
+        json.len()
+    );
+    stream.write_all(head.as_bytes()).await.unwrap();
+    stream.write_all(json.as_bytes()).await.unwrap();
+    let mut answer = Vec::new();
+    stream.read_to_end(&mut answer).await.unwrap();
+    let text = String::from_utf8_lossy(&answer).to_string();
+    let status = text.split(' ').nth(1).and_then(|s| s.parse().ok());
+    let status = status.unwrap_or_else(|| panic!("no HTTP answer: {text:?}"));
+    let body = text.split_once("\r\n\r\n").map(|(_, b)| b).unwrap_or("");
+    let value = serde_json::from_str(body).unwrap_or(Value::String(body.to_string()));
+    (status, value)
+}
+
+fn move_point(dx: f64) -> String {
+    format!(
+        r#"{{"type":"edit","op":{{"op":"move_points","layer":0,"points":[0],"dx":{dx},"dy":0}}}}"#
+    )
+}
+
+fn first_x(path: &Path) -> f64 {
+    let doc = gradmesh::formats::read_path(path).unwrap();
+    doc.layers[0].points[0].position.x
+}
+
+fn assert_refused_as_existing(status: u16, answer: &Value) {
+    assert_eq!(status, 409, "{answer}");
+    assert_eq!(answer["code"], "file_exists", "{answer}");
+    assert!(
+        answer["message"].as_str().unwrap().contains("exists"),
+        "{answer}"
+    );
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn saving_a_document_opened_from_off_asks_before_replacing_its_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let off = dir.path().join("Tucan.off");
+    std::fs::copy(shared_off("Tucan_Tucan_Layer0.off"), &off).unwrap();
+    let json = dir.path().join("Tucan.json");
+    std::fs::write(&json, SQUARE).unwrap();
+    let running = serve(Some(off), dir.path()).await;
+    assert_eq!(command(&running, &move_point(7.0)).await.0, 200);
+
+    let (status, answer) = command(&running, r#"{"type":"save"}"#).await;
+    assert_refused_as_existing(status, &answer);
+    assert_eq!(std::fs::read_to_string(&json).unwrap(), SQUARE, "untouched");
+
+    let (status, state) = command(&running, r#"{"type":"save","overwrite":true}"#).await;
+    assert_eq!(status, 200, "{state}");
+    assert_eq!(state["modified"], false, "{state}");
+    assert_eq!(state["file"], "Tucan.json");
+    assert_eq!(state["saved"]["file"], "Tucan.json", "{state}");
+    assert!(state["saved"]["at"].as_u64().unwrap() > 1_600_000_000_000);
+    let saved = gradmesh::formats::read_path(&json).unwrap();
+    assert_eq!(saved.layers[0].points.len(), 12, "the Tucan's layer");
+
+    // The session wrote it: the next save does not ask.
+    assert_eq!(command(&running, &move_point(1.0)).await.0, 200);
+    let (status, state) = command(&running, r#"{"type":"save"}"#).await;
+    assert_eq!((status, &state["modified"]), (200, &Value::Bool(false)));
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_document_opened_from_off_saves_without_asking_when_its_json_is_new() {
+    let dir = tempfile::tempdir().unwrap();
+    let off = dir.path().join("Tucan.off");
+    std::fs::copy(shared_off("Tucan_Tucan_Layer0.off"), &off).unwrap();
+    let running = serve(Some(off), dir.path()).await;
+    let (status, state) = command(&running, r#"{"type":"save"}"#).await;
+    assert_eq!(status, 200, "{state}");
+    assert!(dir.path().join("Tucan.json").is_file());
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn save_as_onto_an_existing_name_asks_and_a_json_opened_saves_in_place() {
+    let dir = tempfile::tempdir().unwrap();
+    let square = dir.path().join("square.json");
+    std::fs::write(&square, SQUARE).unwrap();
+    let other = dir.path().join("other.json");
+    std::fs::write(&other, SQUARE).unwrap();
+    let running = serve(Some(square.clone()), dir.path()).await;
+    assert_eq!(command(&running, &move_point(5.0)).await.0, 200);
+
+    // The JSON opened is the document's own file: saved in place.
+    let (status, state) = command(&running, r#"{"type":"save"}"#).await;
+    assert_eq!(status, 200, "{state}");
+    assert_eq!(first_x(&square), 5.0);
+
+    // Save as onto a file the session did not write: refused until asked with overwrite.
+    let onto_other = r#"{"type":"save_as","name":"other.json"}"#;
+    let (status, answer) = command(&running, onto_other).await;
+    assert_refused_as_existing(status, &answer);
+    assert_eq!(std::fs::read_to_string(&other).unwrap(), SQUARE);
+    let state = command(&running, r#"{"type":"state"}"#).await.1;
+    assert_eq!(
+        state["file"], "square.json",
+        "a refused save changes nothing"
+    );
+    let overwrite = r#"{"type":"save_as","name":"other.json","overwrite":true}"#;
+    let (status, state) = command(&running, overwrite).await;
+    assert_eq!(status, 200, "{state}");
+    assert_eq!(
+        (first_x(&other), &state["file"]),
+        (5.0, &"other.json".into())
+    );
+
+    // Save as to a new name, then onto it again: the session wrote it, no question.
+    let fresh = r#"{"type":"save_as","name":"fresh.json"}"#;
+    assert_eq!(command(&running, fresh).await.0, 200);
+    assert_eq!(command(&running, &move_point(2.0)).await.0, 200);
+    let (status, state) = command(&running, fresh).await;
+    assert_eq!(status, 200, "{state}");
+    assert_eq!(first_x(&dir.path().join("fresh.json")), 7.0);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_json_opened_from_the_menu_saves_in_place_and_new_forgets_the_last_save() {
+    let dir = tempfile::tempdir().unwrap();
+    let other = dir.path().join("other.json");
+    std::fs::write(&other, SQUARE).unwrap();
+    let running = serve(None, dir.path()).await;
+    let (status, state) = command(&running, r#"{"type":"open","name":"other.json"}"#).await;
+    assert_eq!((status, &state["saved"]), (200, &Value::Null), "{state}");
+    assert_eq!(command(&running, &move_point(3.0)).await.0, 200);
+    let (status, state) = command(&running, r#"{"type":"save"}"#).await;
+    assert_eq!(status, 200, "{state}");
+    assert_eq!(state["saved"]["file"], "other.json");
+    assert_eq!(first_x(&other), 3.0);
+    let (_, state) = command(&running, r#"{"type":"new"}"#).await;
+    assert_eq!(
+        (&state["file"], &state["saved"]),
+        (&Value::Null, &Value::Null)
+    );
+}
