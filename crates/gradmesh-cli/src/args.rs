@@ -376,6 +376,10 @@ pub struct RenderArgs {
     /// The largest image accepted, in pixels (refused before anything is allocated).
     #[arg(long, value_name = "N", default_value_t = gradmesh::render::MAX_PIXELS, help_heading = "Limits")]
     pub max_pixels: u64,
+    /// The most memory, in bytes, that drawing an SVG file's whole picture may need (estimated
+    /// before it is drawn) [default: the machine's memory, MemTotal in /proc/meminfo].
+    #[arg(long, value_name = "BYTES", help_heading = "Limits")]
+    pub max_memory: Option<u64>,
     /// Allow the output to be one of the input files.
     #[arg(long)]
     pub force: bool,

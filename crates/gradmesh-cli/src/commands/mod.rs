@@ -5,6 +5,7 @@ mod edits;
 mod info;
 mod refine;
 mod render;
+mod resvg_guard;
 mod serve;
 mod whole_picture;
 

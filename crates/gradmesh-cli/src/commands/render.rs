@@ -162,8 +162,9 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
             let path = &args.inputs[0];
             let text = std::fs::read_to_string(path)
                 .map_err(|e| Error::new(ErrorKind::Io(format!("{}: {e}", path.display()))))?;
-            let drawn =
-                whole_picture::render_whole_picture(&text, layers, &opts).map_err(locate)?;
+            let max_memory = args.max_memory.unwrap_or_else(machine_memory);
+            let drawn = whole_picture::render_whole_picture(&text, layers, &opts, max_memory)
+                .map_err(|e| locate(e).in_file(path))?;
             print_left_out(path, &left_out[0].1, drawn.is_ok());
             if let Err(message) = &drawn {
                 eprintln!(
@@ -393,6 +394,19 @@ fn warn(w: &gradmesh::Warning, origins: &[(&std::path::Path, usize)]) {
         ),
         None => eprintln!("gradmesh: warning: {w}"),
     }
+}
+
+/// The machine's memory in bytes (MemTotal in /proc/meminfo), or no limit where it is not
+/// known.
+fn machine_memory() -> u64 {
+    std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|text| {
+            let line = text.lines().find(|l| l.starts_with("MemTotal:"))?;
+            let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+            Some(kib.saturating_mul(1024))
+        })
+        .unwrap_or(u64::MAX)
 }
 
 /// The rendered picture, in the type it was drawn in.

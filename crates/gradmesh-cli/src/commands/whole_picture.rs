@@ -21,8 +21,10 @@ use std::collections::HashSet;
 use std::ops::Range;
 
 use gradmesh::render::{self, Image, PictureLayer, RenderOptions};
-use gradmesh::Error;
+use gradmesh::{Error, ErrorKind};
 use roxmltree::{Document, Node};
+
+use super::resvg_guard;
 
 const SVG_NS: &str = "http://www.w3.org/2000/svg";
 
@@ -288,21 +290,78 @@ impl<'a, 'input> Segments<'a, 'input> {
     }
 }
 
-/// Renders one segment's text with resvg into a premultiplied RGBA8 pixmap.
+/// The whole picture's memory, in bytes per pixel: the premultiplied `f32` canvas, the `f32`
+/// mesh layer and resvg's RGBA8 segment (36), and the mesh renderer's working memory and the
+/// PNG's encoding; the peak measured is 39 bytes a pixel (`docs/svg.md`).
+pub const BYTES_PER_PIXEL: u64 = 16 + 16 + 4 + 8;
+
+/// An error for a panic inside resvg or usvg.
+fn panicked(message: String) -> Error {
+    Error::new(ErrorKind::Invalid {
+        what: "the rest of the picture (what is not a mesh fill)".into(),
+        message: format!("resvg failed ({message}), so it could not be drawn"),
+    })
+}
+
+/// Refuses `bytes` of memory over `max_memory`.
+fn check_memory(bytes: u64, max_memory: u64, opts: &RenderOptions) -> Result<(), Error> {
+    if bytes > max_memory {
+        return Err(Error::new(ErrorKind::LimitExceeded {
+            what: format!(
+                "the memory the whole picture at {}x{} needs (estimated: {BYTES_PER_PIXEL} \
+                 bytes a pixel and resvg's layers; see --max-memory)",
+                opts.width, opts.height
+            ),
+            found: bytes,
+            limit: max_memory,
+        }));
+    }
+    Ok(())
+}
+
+/// Renders one segment's text with resvg into a premultiplied RGBA8 pixmap, after checking
+/// the buffers resvg would allocate against `opts.max_pixels` and, with `base` bytes already
+/// in use, `max_memory`. `Ok(Err(message))` when resvg cannot parse the text.
 fn render_segment(
     text: &str,
     options: &resvg::usvg::Options,
     opts: &RenderOptions,
-) -> Result<resvg::tiny_skia::Pixmap, String> {
-    let tree = resvg::usvg::Tree::from_str(text, options).map_err(|e| e.to_string())?;
-    let mut pixmap = resvg::tiny_skia::Pixmap::new(opts.width, opts.height)
-        .ok_or_else(|| format!("resvg cannot allocate {}x{}", opts.width, opts.height))?;
-    resvg::render(
-        &tree,
-        resvg::tiny_skia::Transform::identity(),
-        &mut pixmap.as_mut(),
-    );
-    Ok(pixmap)
+    (base, max_memory): (u64, u64),
+) -> Result<Result<resvg::tiny_skia::Pixmap, String>, Error> {
+    let parsed =
+        resvg_guard::catching(|| resvg::usvg::Tree::from_str(text, options)).map_err(panicked)?;
+    let tree = match parsed {
+        Ok(tree) => tree,
+        Err(e) => return Ok(Err(e.to_string())),
+    };
+    let canvas = resvg_guard::Canvas {
+        width: opts.width,
+        height: opts.height,
+        max_pixels: opts.max_pixels,
+    };
+    let layers = resvg_guard::check_tree(&tree, &canvas).map_err(|e| {
+        Error::new(ErrorKind::LimitExceeded {
+            what: e.what,
+            found: e.found,
+            limit: e.limit,
+        })
+    })?;
+    check_memory(base.saturating_add(layers), max_memory, opts)?;
+    let Some(mut pixmap) = resvg::tiny_skia::Pixmap::new(opts.width, opts.height) else {
+        return Ok(Err(format!(
+            "resvg cannot allocate {}x{}",
+            opts.width, opts.height
+        )));
+    };
+    resvg_guard::catching(|| {
+        resvg::render(
+            &tree,
+            resvg::tiny_skia::Transform::identity(),
+            &mut pixmap.as_mut(),
+        )
+    })
+    .map_err(panicked)?;
+    Ok(Ok(pixmap))
 }
 
 /// resvg's options: the system's fonts, and for each generic family (and text that names no
@@ -372,11 +431,14 @@ fn composite_image(acc: &mut [f32], over: &[f32]) {
 /// The whole picture of SVG `text`: `mesh_layers` (its mesh fills, bottom first, as gradmesh
 /// read them) between the rest of its content drawn by resvg, on `opts.background`. Straight
 /// alpha, like every [`Image`]. `Ok(Err(message))` when the file's content cannot be split
-/// around its mesh fills (the caller then draws the meshes alone).
+/// around its mesh fills or resvg cannot read it (the caller then draws the meshes alone).
+/// An error when resvg panics, or when the picture's memory (estimated) is over `max_memory`
+/// or a buffer resvg would allocate is over `opts.max_pixels`.
 pub fn render_whole_picture(
     text: &str,
     mesh_layers: &[PictureLayer<'_>],
     opts: &RenderOptions,
+    max_memory: u64,
 ) -> Result<Result<(Image, render::RenderInfo), String>, Error> {
     let doc = match Document::parse_with_options(
         text,
@@ -399,6 +461,9 @@ pub fn render_whole_picture(
              copy of the file: over the limit of {MAX_SEGMENT_TEXT} bytes in all"
         )));
     }
+    let pixels = u64::from(opts.width) * u64::from(opts.height);
+    let base = pixels.saturating_mul(BYTES_PER_PIXEL);
+    check_memory(base, max_memory, opts)?;
     let options = resvg_options();
     let mut acc = background_canvas(opts);
     let mut layer_opts = opts.clone();
@@ -425,7 +490,7 @@ pub fn render_whole_picture(
     for s in 0..=mesh_layers.len() {
         if segments.drawing[s] {
             draw_meshes_below(s, &mut acc)?;
-            match render_segment(&segments.text(s), &options, opts) {
+            match render_segment(&segments.text(s), &options, opts, (base, max_memory))? {
                 Ok(pixmap) => composite_pixmap(&mut acc, &pixmap),
                 Err(message) => return Ok(Err(message)),
             }
