@@ -203,6 +203,33 @@ fn blend(base: &BaseMesh, vertices: &[u32], position: Point) -> VertexData {
     d
 }
 
+/// The base vertices whose mean colour and opacity each level-1 vertex takes (colours do not
+/// depend on positions or handles): a control point's ring its own vertex, an edge's midpoint
+/// its two ends, an inner point the two ends of its side, a face centre the face's corners.
+/// Numbered as the level-1 vertices.
+pub fn colour_sources(t: &Topology) -> Vec<Vec<u32>> {
+    let mut sources = vec![Vec::new(); level1_vertex_count(t)];
+    for v in 0..t.vertex_count() as u32 {
+        sources[v as usize] = vec![v];
+    }
+    for e in 0..t.edge_count() as u32 {
+        let ends = t.edge_vertices(e as usize);
+        for (end, &v) in ends.iter().enumerate() {
+            sources[edge_point(t, e, end) as usize] = vec![v];
+        }
+        sources[edge_midpoint(t, e) as usize] = ends.to_vec();
+    }
+    for f in 0..t.face_count() {
+        let (fv, o) = (t.face_vertices(f), t.face_offset(f));
+        for (i, &v) in fv.iter().enumerate() {
+            sources[face_point(t, o + i) as usize] = vec![v];
+            sources[inner_point(t, o + i) as usize] = vec![v, fv[(i + 1) % fv.len()]];
+        }
+        sources[face_centre(t, f) as usize] = fv.to_vec();
+    }
+    sources
+}
+
 /// The level-1 data of `base` (derivation in `docs/binary-step.md`).
 ///
 /// * The ring of each control point `V` (its quarter points and ring face points) has `V`'s
@@ -289,6 +316,25 @@ mod tests {
         mesh.add_face([0, 1, 2, 3]);
         mesh.add_face([1, 4, 2]);
         BaseMesh::new(&mesh).unwrap().0
+    }
+
+    /// Level 1's colours and opacities are the means of the colours of [`colour_sources`].
+    #[test]
+    fn colours_are_the_means_of_their_sources() {
+        let mut base = square_and_triangle();
+        for (v, d) in base.data.iter_mut().enumerate() {
+            d[5] = 0.2 + 0.15 * v as f64;
+        }
+        let data = binary_data(&base);
+        let sources = colour_sources(&base.topology);
+        assert_eq!(sources.len(), data.len());
+        for (d, src) in data.iter().zip(&sources) {
+            for c in 2..6 {
+                let mean =
+                    src.iter().map(|&s| base.data[s as usize][c]).sum::<f64>() / src.len() as f64;
+                assert!((d[c] - mean).abs() < 1e-12, "{d:?} from {src:?}");
+            }
+        }
     }
 
     #[test]

@@ -437,6 +437,16 @@ fn face_point_from_weights(v0: Point, d1: Vec2, d2: Vec2, w1: f64, w2: f64, c: P
     v0 + d1 * (1.0 - w2) + d2 * (1.0 - w1) + (c - v0) * (w1 * w2)
 }
 
+/// The base vertex whose colour and opacity each level-1 vertex copies (the ternary step's
+/// colours do not depend on positions or handles): a vertex point its own vertex, an edge
+/// point the end it lies near, a face point the corner it lies at.
+pub fn colour_sources(t: &Topology) -> Vec<u32> {
+    let mut sources: Vec<u32> = (0..t.vertex_count() as u32).collect();
+    sources.extend((0..t.edge_count()).flat_map(|e| t.edge_vertices(e)));
+    sources.extend_from_slice(&t.face_verts);
+    sources
+}
+
 /// The level-1 data of `base`: positions from the handles, colours copied from the control
 /// point each new point surrounds.
 pub fn ternary_data(base: &BaseMesh) -> Vec<VertexData> {
@@ -573,6 +583,29 @@ mod tests {
             Point::new(1.5, 1.5),
         );
         assert!((f - Point::new(1.0, 1.0)).hypot() < 1e-12);
+    }
+
+    /// Each level-1 vertex copies the colour and opacity of its [`colour_sources`] vertex.
+    #[test]
+    fn colours_are_copied_from_their_sources() {
+        use crate::{ColourSpace, GradientMesh};
+        let mut m = GradientMesh::new(ColourSpace::Lab);
+        for (i, (x, y)) in [(0.0, 0.0), (4.0, 0.0), (4.0, 4.0), (0.0, 4.0), (7.0, 2.0)]
+            .into_iter()
+            .enumerate()
+        {
+            let p = m.add_point(Point::new(x, y), [x * 10.0, y * 10.0, i as f64]);
+            m.points[p as usize].opacity = 0.5 + 0.1 * i as f64;
+        }
+        m.add_face([0, 1, 2, 3]);
+        m.add_face([1, 4, 2]);
+        let base = BaseMesh::new(&m).unwrap().0;
+        let data = ternary_data(&base);
+        let sources = colour_sources(&base.topology);
+        assert_eq!(sources.len(), data.len());
+        for (d, &s) in data.iter().zip(&sources) {
+            assert_eq!(d[2..], base.data[s as usize][2..]);
+        }
     }
 
     /// The direct construction gives the connectivity that building from the faces gives.

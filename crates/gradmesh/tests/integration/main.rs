@@ -24,6 +24,7 @@ mod errors_doc;
 mod export;
 mod formats;
 mod fuzz_replay;
+mod limit_matrix;
 mod opensubdiv_oracle;
 mod options;
 mod properties;
