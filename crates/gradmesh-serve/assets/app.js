@@ -89,6 +89,8 @@ function receiveText(message) {
     // files.js asked the user.
   } else if (message.type === "error" || message.type === "notice") {
     showMessage(message.message);
+  } else if (message.type === "select") {
+    editor.chosen = message; // what a mesh tool made: selected once the state has it
   } else if (message.type === "state") {
     const first = editor.state === null;
     const folds = editor.state ? editor.state.layers.map((l) => l.folds) : [];
@@ -97,6 +99,14 @@ function receiveText(message) {
       message.layers.forEach((layer, i) => { layer.folds = folds[i] || []; });
     }
     if (editor.activeLayer >= message.layers.length) editor.activeLayer = Math.max(0, message.layers.length - 1);
+    if (editor.chosen) {
+      const chosen = editor.chosen;
+      editor.chosen = null;
+      editor.activeLayer = chosen.layer;
+      editor.selection = chosen.points;
+      editor.face = chosen.face;
+      editor.edge = null;
+    }
     const layer = activeLayer();
     if (layer) editor.selection = editor.selection.filter((p) => p < layer.points.length);
     if (first) fitView();
@@ -371,6 +381,7 @@ function handleEnd(layer, from, to) {
 }
 
 function drawBox(c) {
+  if (editor.tools) editor.tools.draw(c);
   const d = editor.drag;
   if (!d || d.kind !== "box") return;
   c.strokeStyle = "#4af"; c.setLineDash([4, 3]); c.lineWidth = 1;
@@ -450,6 +461,7 @@ overlay.addEventListener("pointerdown", (event) => {
     editor.drag = { kind: "pan", start: at, view: { ...editor.view } };
     return;
   }
+  if (editor.tools && editor.tools.pointerDown(event, at)) return;
   const layer = activeLayer();
   if (!layer || layer.hidden) return;
   const refined = pickRefined(...at);
@@ -491,6 +503,7 @@ overlay.addEventListener("pointerdown", (event) => {
 });
 
 overlay.addEventListener("pointermove", (event) => {
+  if (editor.tools && editor.tools.pointerMove(event, eventPosition(event))) return;
   if (editor.drag) dragTo(editor.drag, eventPosition(event));
 });
 
@@ -529,6 +542,7 @@ function dragTo(d, at) {
 }
 
 overlay.addEventListener("pointerup", (event) => {
+  if (editor.tools && editor.tools.pointerUp(event, eventPosition(event))) return;
   const d = editor.drag;
   editor.drag = null;
   if (!d) return;
@@ -578,6 +592,7 @@ window.addEventListener("keydown", (event) => {
   else if (ctrl && key === "y") { send({ type: "redo" }); }
   else if (ctrl && key === "s") { save(); }
   else if (ctrl) { return; }
+  else if (editor.tools && editor.tools.key(event, key)) { /* a tool's key (tools.js) */ }
   else if (event.key === " ") { spaceDown = true; }
   else if (event.key === "Delete" || event.key === "Backspace") { deleteSelection(); }
   else if (event.key === "Escape") { editor.selection = []; editor.edge = null; editor.face = null; }

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use gradmesh::formats::{self, Format};
 use gradmesh::{ColourSpace, Document, GradientMesh};
 
-use crate::ops::{Op, Picture};
+use crate::ops::{Applied, Op, Picture};
 
 /// Undo and redo steps kept at most.
 pub const MAX_HISTORY: usize = 500;
@@ -49,13 +49,19 @@ impl History {
     /// [`Op::apply`]). The result must pass the validator (every layer); else the picture stays
     /// as it was and the validator's message is returned.
     pub fn apply(&mut self, op: &Op, gesture: Option<u64>) -> Result<Option<String>, String> {
+        self.apply_selecting(op, gesture)
+            .map(|applied| applied.note)
+    }
+
+    /// [`History::apply`], with what a mesh tool leaves selected.
+    pub fn apply_selecting(&mut self, op: &Op, gesture: Option<u64>) -> Result<Applied, String> {
         let continuing = gesture.is_some() && gesture == self.gesture && !self.undo.is_empty();
         let mut next = if continuing {
             self.undo.last().expect("a gesture has its start").clone()
         } else {
             self.current.clone()
         };
-        let note = op.apply(&mut next)?;
+        let applied = op.apply_selecting(&mut next)?;
         check_picture(&next, Some(&self.current))?;
         if !continuing {
             self.undo.push(std::mem::replace(&mut self.current, next));
@@ -68,7 +74,7 @@ impl History {
         self.redo.clear();
         self.gesture = gesture;
         self.version += 1;
-        Ok(note)
+        Ok(applied)
     }
 
     /// Ends the open gesture: the next edit starts a new step.

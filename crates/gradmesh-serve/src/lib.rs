@@ -18,6 +18,7 @@ pub mod security;
 pub mod server;
 pub mod session;
 pub mod state;
+pub mod tools;
 pub mod viewer;
 
 use std::net::SocketAddr;

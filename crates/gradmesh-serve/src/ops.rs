@@ -8,8 +8,10 @@ use gradmesh::{
     parse_css_colour, ColourSpace, Document, EdgeKind, Edit, GradientMesh, VertexAddress,
     SHARPNESS_INFINITE,
 };
-use kurbo::{CubicBez, ParamCurve, Point, Vec2};
+use kurbo::{Point, Vec2};
 use serde::Deserialize;
+
+use crate::tools::{self, remove_faces_and_points, Selection, ToolResult};
 
 /// What the editor shows: the document and, per layer, whether it is hidden.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -90,6 +92,16 @@ pub enum Op {
         /// A CSS colour (`#rrggbb`, `rgb(...)`, names).
         #[serde(default)]
         css: Option<String>,
+    },
+    /// Sets each of `points` to its own CSS colour (`css[i]` for `points[i]`), as the
+    /// eyedropper does.
+    SetColours {
+        /// The layer.
+        layer: usize,
+        /// The points.
+        points: Vec<u32>,
+        /// Their colours.
+        css: Vec<String>,
     },
     /// Sets the opacity of `points`.
     SetOpacity {
@@ -266,6 +278,85 @@ pub enum Op {
         /// The move in y.
         dy: f64,
     },
+    /// Adds a grid of `columns` x `rows` quads over `rect` (1 to 64 each way).
+    AddGrid {
+        /// The layer.
+        layer: usize,
+        /// Two opposite corners: x0, y0, x1, y1.
+        rect: [f64; 4],
+        /// Quads across.
+        columns: u32,
+        /// Quads down.
+        rows: u32,
+    },
+    /// Adds a mesh filling the ellipse inscribed in `rect`.
+    AddEllipse {
+        /// The layer.
+        layer: usize,
+        /// Two opposite corners of the ellipse's box: x0, y0, x1, y1.
+        rect: [f64; 4],
+    },
+    /// Adds a mesh filling the polygon `outline`.
+    AddOutline {
+        /// The layer.
+        layer: usize,
+        /// The polygon's corners in order.
+        outline: Vec<[f64; 2]>,
+    },
+    /// Cuts the strip of quads holding the edge from `a` to `b` with a line of new points, at
+    /// `at` along the edge (0 at `a`, 1 at `b`; default the middle).
+    LoopCut {
+        /// The layer.
+        layer: usize,
+        /// One end of the edge clicked.
+        a: u32,
+        /// The other end.
+        b: u32,
+        /// Where along the edge, between 0 and 1.
+        #[serde(default = "half")]
+        at: f64,
+    },
+    /// Adds a point at `(x, y)` inside `face`, joined to each corner.
+    AddPointInFace {
+        /// The layer.
+        layer: usize,
+        /// The face.
+        face: u32,
+        /// The point's x.
+        x: f64,
+        /// The point's y.
+        y: f64,
+    },
+    /// Removes `points`, each merging the faces around it into one.
+    DissolvePoints {
+        /// The layer.
+        layer: usize,
+        /// The points.
+        points: Vec<u32>,
+    },
+    /// Removes the edge between `a` and `b`, merging its two faces into one.
+    DissolveEdge {
+        /// The layer.
+        layer: usize,
+        /// One end.
+        a: u32,
+        /// The other end.
+        b: u32,
+    },
+}
+
+fn half() -> f64 {
+    0.5
+}
+
+/// What an edit did besides its change: a note for the user, and what a mesh tool leaves
+/// selected.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Applied {
+    /// A note for the user (the edit did more than asked).
+    pub note: Option<String>,
+    /// The points and face to select next.
+    pub selection: Option<Selection>,
 }
 
 impl Op {
@@ -274,6 +365,23 @@ impl Op {
     /// user when the edit names nothing that exists or makes no sense; the validity of the
     /// result is checked apart.
     pub fn apply(&self, picture: &mut Picture) -> Result<Option<String>, String> {
+        self.apply_selecting(picture).map(|applied| applied.note)
+    }
+
+    /// [`Op::apply`], with what a mesh tool leaves selected.
+    pub fn apply_selecting(&self, picture: &mut Picture) -> Result<Applied, String> {
+        if let Some(result) = self.apply_tool(picture) {
+            return result;
+        }
+        let note = self.apply_edit(picture)?;
+        Ok(Applied {
+            note,
+            selection: None,
+        })
+    }
+
+    /// Applies an edit that is not a mesh tool; returns its note.
+    fn apply_edit(&self, picture: &mut Picture) -> Result<Option<String>, String> {
         match self {
             Op::AddLayer { name } => {
                 let mut mesh = GradientMesh::new(ColourSpace::Lab);
@@ -329,12 +437,57 @@ impl Op {
         }
     }
 
+    /// Applies a mesh tool; `None` for the other edits.
+    fn apply_tool(&self, picture: &mut Picture) -> Option<Result<Applied, String>> {
+        let layer = self.layer();
+        let mut run = |tool: &dyn Fn(&mut GradientMesh) -> Result<ToolResult, String>| {
+            check_layer(picture, layer)?;
+            let result = tool(&mut picture.doc.layers[layer])?;
+            let mut selection = result.selection;
+            selection.layer = layer;
+            Ok(Applied {
+                note: result.note,
+                selection: Some(selection),
+            })
+        };
+        let merged = |(face, note): (Option<u32>, Option<String>)| ToolResult {
+            selection: Selection {
+                layer,
+                points: Vec::new(),
+                face,
+            },
+            note,
+        };
+        Some(match self {
+            Op::AddGrid {
+                rect,
+                columns,
+                rows,
+                ..
+            } => run(&|mesh| tools::add_grid(mesh, *rect, *columns, *rows)),
+            Op::AddEllipse { rect, .. } => run(&|mesh| tools::add_ellipse(mesh, *rect)),
+            Op::AddOutline { outline, .. } => run(&|mesh| tools::add_outline(mesh, outline)),
+            Op::LoopCut { a, b, at, .. } => run(&|mesh| tools::loop_cut(mesh, *a, *b, *at)),
+            Op::AddPointInFace { face, x, y, .. } => {
+                run(&|mesh| tools::add_point_in_face(mesh, *face, Point::new(*x, *y)))
+            }
+            Op::DissolvePoints { points, .. } => {
+                run(&|mesh| tools::dissolve_points(mesh, points).map(merged))
+            }
+            Op::DissolveEdge { a, b, .. } => run(&|mesh| {
+                tools::dissolve_edge(mesh, *a, *b).map(|(face, note)| merged((Some(face), note)))
+            }),
+            _ => return None,
+        })
+    }
+
     /// The layer an edit of one mesh changes.
     fn layer(&self) -> usize {
         match self {
             Op::MovePoints { layer, .. }
             | Op::SetHandle { layer, .. }
             | Op::SetColour { layer, .. }
+            | Op::SetColours { layer, .. }
             | Op::SetOpacity { layer, .. }
             | Op::SetEdge { layer, .. }
             | Op::SplitEdge { layer, .. }
@@ -350,7 +503,14 @@ impl Op {
             | Op::SetSideColour { layer, .. }
             | Op::SetSideOpacity { layer, .. }
             | Op::SetRefinedEdit { layer, .. }
-            | Op::MoveRefinedVertex { layer, .. } => *layer,
+            | Op::MoveRefinedVertex { layer, .. }
+            | Op::AddGrid { layer, .. }
+            | Op::AddEllipse { layer, .. }
+            | Op::AddOutline { layer, .. }
+            | Op::LoopCut { layer, .. }
+            | Op::AddPointInFace { layer, .. }
+            | Op::DissolvePoints { layer, .. }
+            | Op::DissolveEdge { layer, .. } => *layer,
             Op::AddLayer { .. } => 0,
         }
     }
@@ -374,6 +534,19 @@ impl Op {
                 css,
                 ..
             } => set_colour(mesh, points, *colour, css.as_deref()),
+            Op::SetColours { points, css, .. } => {
+                if points.len() != css.len() {
+                    return Err(format!(
+                        "{} points but {} colours: give one colour per point",
+                        points.len(),
+                        css.len()
+                    ));
+                }
+                for (&p, text) in points.iter().zip(css) {
+                    set_colour(mesh, &[p], None, Some(text))?;
+                }
+                Ok(())
+            }
             Op::SetOpacity {
                 points, opacity, ..
             } => {
@@ -447,7 +620,16 @@ impl Op {
             | Op::MoveLayer { .. }
             | Op::SetLayerHidden { .. }
             | Op::RenameLayer { .. }
-            | Op::DeleteLayer { .. } => unreachable!("layer edits are applied to the picture"),
+            | Op::DeleteLayer { .. }
+            | Op::AddGrid { .. }
+            | Op::AddEllipse { .. }
+            | Op::AddOutline { .. }
+            | Op::LoopCut { .. }
+            | Op::AddPointInFace { .. }
+            | Op::DissolvePoints { .. }
+            | Op::DissolveEdge { .. } => {
+                unreachable!("layer edits and mesh tools are applied to the picture")
+            }
         }
     }
 }
@@ -646,48 +828,13 @@ fn set_edge(
     Ok(())
 }
 
-/// The edge's curve from `a` to `b`: a cubic through the two handles.
-fn edge_curve(mesh: &GradientMesh, a: u32, b: u32) -> CubicBez {
-    let (pa, pb) = (
-        mesh.points[a as usize].position,
-        mesh.points[b as usize].position,
-    );
-    CubicBez::new(pa, pa + mesh.handle(a, b), pb + mesh.handle(b, a), pb)
-}
-
 fn split_edge(mesh: &mut GradientMesh, a: u32, b: u32) -> Result<(), String> {
     check_edge(mesh, a, b)?;
-    let curve = edge_curve(mesh, a, b);
-    let (first, second) = curve.subdivide();
     let (ca, cb) = (&mesh.points[a as usize], &mesh.points[b as usize]);
     let colour = [0, 1, 2].map(|i| (ca.colour[i] + cb.colour[i]) / 2.0);
     let opacity = (ca.opacity + cb.opacity) / 2.0;
-    let m = mesh.add_point(curve.eval(0.5), colour);
-    mesh.points[m as usize].opacity = opacity;
-    for face in &mut mesh.faces {
-        let n = face.len();
-        if let Some(i) = (0..n).find(|&i| {
-            let (p, q) = (face[i], face[(i + 1) % n]);
-            (p, q) == (a, b) || (p, q) == (b, a)
-        }) {
-            face.insert(i + 1, m);
-        }
-    }
-    let tag = mesh.edge_tag(a, b);
-    mesh.edges.remove(&gradmesh_edge_key(a, b));
-    mesh.handles.remove(&(a, b));
-    mesh.handles.remove(&(b, a));
-    mesh.set_handle(a, m, first.p1 - first.p0);
-    mesh.set_handle(m, a, first.p2 - first.p3);
-    mesh.set_handle(m, b, second.p1 - second.p0);
-    mesh.set_handle(b, m, second.p2 - second.p3);
-    mesh.set_edge(a, m, tag.kind, tag.sharpness);
-    mesh.set_edge(m, b, tag.kind, tag.sharpness);
+    tools::insert_point_on_edge(mesh, a, b, 0.5, colour, opacity);
     Ok(())
-}
-
-fn gradmesh_edge_key(a: u32, b: u32) -> (u32, u32) {
-    (a.min(b), a.max(b))
 }
 
 fn split_face(mesh: &mut GradientMesh, face: u32, a: u32, b: u32) -> Result<(), String> {
@@ -718,20 +865,7 @@ fn split_face(mesh: &mut GradientMesh, face: u32, a: u32, b: u32) -> Result<(), 
 }
 
 fn add_rectangle(mesh: &mut GradientMesh, [x0, y0, x1, y1]: [f64; 4]) {
-    let palette: [[f64; 3]; 4] = match mesh.colour_space {
-        ColourSpace::Lab => [
-            [60.0, 60.0, 40.0],
-            [85.0, -10.0, 80.0],
-            [50.0, -40.0, -30.0],
-            [40.0, 50.0, -60.0],
-        ],
-        _ => [
-            [0.9, 0.3, 0.2],
-            [0.95, 0.85, 0.2],
-            [0.2, 0.6, 0.7],
-            [0.4, 0.2, 0.7],
-        ],
-    };
+    let palette = tools::palette(mesh.colour_space);
     let corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)];
     let ids: Vec<u32> = corners
         .iter()
@@ -756,89 +890,6 @@ fn delete_faces(mesh: &mut GradientMesh, faces: &[u32]) -> Result<(), String> {
         return Err(format!("there is no face {f}"));
     }
     remove_faces_and_points(mesh, faces, &[])
-}
-
-/// Removes `faces`, the points in `points`, and every point no face uses any more; numbers the
-/// rest in order and carries handles, edge tags, sides and multi-resolution edits over to the
-/// new numbers. Sides and edits on removed faces are dropped.
-fn remove_faces_and_points(
-    mesh: &mut GradientMesh,
-    faces: &[u32],
-    points: &[u32],
-) -> Result<(), String> {
-    let kept_faces: Vec<Vec<u32>> = (mesh.faces.iter().enumerate())
-        .filter(|(f, _)| !faces.contains(&(*f as u32)))
-        .map(|(_, corners)| corners.clone())
-        .collect();
-    let mut used = vec![false; mesh.points.len()];
-    for corner in kept_faces.iter().flatten() {
-        used[*corner as usize] = true;
-    }
-    for &p in points {
-        used[p as usize] = false;
-    }
-    let mut new_index = vec![u32::MAX; mesh.points.len()];
-    let mut next = 0u32;
-    for (p, &keep) in used.iter().enumerate() {
-        if keep {
-            new_index[p] = next;
-            next += 1;
-        }
-    }
-    let old_faces: Vec<usize> = (0..mesh.faces.len())
-        .filter(|f| !faces.contains(&(*f as u32)))
-        .collect();
-    let renumber = |p: u32| new_index[p as usize];
-    mesh.points = (mesh.points.iter().zip(&used))
-        .filter(|(_, &keep)| keep)
-        .map(|(p, _)| p.clone())
-        .collect();
-    mesh.faces = kept_faces
-        .into_iter()
-        .map(|corners| corners.into_iter().map(renumber).collect())
-        .collect();
-    let alive = |&(a, b): &(u32, u32)| used[a as usize] && used[b as usize];
-    mesh.handles = std::mem::take(&mut mesh.handles)
-        .into_iter()
-        .filter(|(key, _)| alive(key))
-        .map(|((a, b), h)| ((renumber(a), renumber(b)), h))
-        .collect();
-    mesh.edges = std::mem::take(&mut mesh.edges)
-        .into_iter()
-        .filter(|(key, _)| alive(key))
-        .map(|((a, b), t)| (gradmesh_edge_key(renumber(a), renumber(b)), t))
-        .collect();
-    mesh.wedges = std::mem::take(&mut mesh.wedges)
-        .into_iter()
-        .filter_map(|mut w| {
-            let face = old_faces.iter().position(|&f| f == w.face as usize)?;
-            if !used[w.point as usize] || w.handles.keys().any(|&n| !used[n as usize]) {
-                return None;
-            }
-            w.point = renumber(w.point);
-            w.face = face as u32;
-            w.handles = w
-                .handles
-                .into_iter()
-                .map(|(n, h)| (renumber(n), h))
-                .collect();
-            Some(w)
-        })
-        .collect();
-    // An edit names a vertex by a face, one of its corners and a place in that corner's
-    // sector: a kept face keeps its corners in order, so only the numbers change.
-    mesh.edits = std::mem::take(&mut mesh.edits)
-        .into_iter()
-        .filter_map(|mut e| {
-            let face = old_faces
-                .iter()
-                .position(|&f| f == e.address.face as usize)?;
-            e.address.face = face as u32;
-            e.address.point = renumber(e.address.point);
-            Some(e)
-        })
-        .collect();
-    Ok(())
 }
 
 fn set_refined_edit(

@@ -27,6 +27,7 @@ pub const PNG_SIDE: u32 = 2048;
 const INDEX_HTML: &str = include_str!("../assets/index.html");
 const APP_JS: &str = include_str!("../assets/app.js");
 const FILES_JS: &str = include_str!("../assets/files.js");
+const TOOLS_JS: &str = include_str!("../assets/tools.js");
 const STYLE_CSS: &str = include_str!("../assets/style.css");
 
 /// The routes, each behind the gate.
@@ -41,6 +42,10 @@ pub fn router(app: Arc<App>, gate: Gate) -> Router {
         .route(
             "/files.js",
             get(|| asset(FILES_JS, "text/javascript; charset=utf-8")),
+        )
+        .route(
+            "/tools.js",
+            get(|| asset(TOOLS_JS, "text/javascript; charset=utf-8")),
         )
         .route(
             "/style.css",
@@ -108,10 +113,11 @@ async fn command(State(app): State<Arc<App>>, body: Bytes) -> Response {
 }
 
 /// The answer of the HTTP API: the first error (422) or the state (200), with the edits' notes
-/// in its `notices`.
+/// in its `notices` and what a mesh tool left selected in its `selection`.
 fn reply(messages: Vec<Outgoing>) -> Response {
     let mut state = None;
     let mut notices = Vec::new();
+    let mut selection = None;
     for message in messages {
         match message {
             Outgoing::Error(text) => {
@@ -124,11 +130,12 @@ fn reply(messages: Vec<Outgoing>) -> Response {
             }
             Outgoing::Text(text) => state = Some(text),
             Outgoing::Notice(text) => notices.push(text),
+            Outgoing::Select(text) => selection = Some(text),
             Outgoing::Binary(_) | Outgoing::Done => {}
         }
     }
     match state {
-        Some(text) if notices.is_empty() => {
+        Some(text) if notices.is_empty() && selection.is_none() => {
             ([(header::CONTENT_TYPE, "application/json")], text).into_response()
         }
         Some(text) => {
@@ -139,6 +146,9 @@ fn reply(messages: Vec<Outgoing>) -> Response {
                 notice["message"].clone()
             });
             state["notices"] = notes.collect();
+            if let Some(text) = selection {
+                state["selection"] = serde_json::from_str(&text).expect("a selection is JSON");
+            }
             let text = state.to_string();
             ([(header::CONTENT_TYPE, "application/json")], text).into_response()
         }
@@ -261,9 +271,10 @@ async fn run_socket(socket: WebSocket, app: Arc<App>) {
         session = Some(back);
         for message in messages {
             let message = match message {
-                Outgoing::Text(text) | Outgoing::Error(text) | Outgoing::Notice(text) => {
-                    Message::Text(text.into())
-                }
+                Outgoing::Text(text)
+                | Outgoing::Error(text)
+                | Outgoing::Notice(text)
+                | Outgoing::Select(text) => Message::Text(text.into()),
                 Outgoing::Binary(bytes) => Message::Binary(bytes.into()),
                 Outgoing::Done => Message::Text(r#"{"type":"done"}"#.into()),
             };

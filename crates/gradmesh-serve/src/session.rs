@@ -11,6 +11,7 @@ use crate::files::{self, FileState, Refusal};
 use crate::ops::Op;
 use crate::security::Folder;
 use crate::state::{FoldCache, Status};
+use crate::tools::Selection;
 use crate::viewer::{Viewer, Viewport};
 
 /// The server's shared state: the document being edited and the folder it lives in.
@@ -107,6 +108,9 @@ pub enum Outgoing {
     Error(String),
     /// JSON: a note about an edit that was made (`{"type": "notice", "message": …}`).
     Notice(String),
+    /// JSON: what a mesh tool leaves selected (`{"type": "select", "layer": L, "points": [...],
+    /// "face": F or null}`).
+    Select(String),
     /// A frame (see [`crate::viewer::encode_frame`]).
     Binary(Vec<u8>),
     /// The end of the answer to a batch of commands: the page may send the next batch.
@@ -121,6 +125,8 @@ pub struct Session {
     /// the generation of the file state.
     told_version: Option<(u64, bool, u64)>,
     folds: FoldCache,
+    /// What the last edit's mesh tool left selected, not yet sent.
+    selected: Option<Selection>,
 }
 
 impl Session {
@@ -131,6 +137,7 @@ impl Session {
             viewer: Viewer::new(),
             told_version: None,
             folds: FoldCache::default(),
+            selected: None,
         }
     }
 
@@ -165,6 +172,11 @@ impl Session {
                 )),
                 Ok(None) => {}
                 Err(refusal) => out.push(Outgoing::Error(refusal.to_json())),
+            }
+            if let Some(selection) = self.selected.take() {
+                let mut message = serde_json::json!(selection);
+                message["type"] = "select".into();
+                out.push(Outgoing::Select(message.to_string()));
             }
         }
         let doc = self.app.editor().history.current().visible();
@@ -214,7 +226,10 @@ impl Session {
         let mut note = None;
         let done = match command {
             Command::Edit { op, gesture } => {
-                (editor.history.apply(op, *gesture)).map(|edit_note| note = edit_note)
+                (editor.history.apply_selecting(op, *gesture)).map(|applied| {
+                    note = applied.note;
+                    self.selected = applied.selection;
+                })
             }
             Command::State => Ok(()),
             Command::EndGesture => {
@@ -308,7 +323,7 @@ mod tests {
         for message in out {
             match message {
                 Outgoing::Binary(_) => n.0 += 1,
-                Outgoing::Text(_) | Outgoing::Notice(_) => n.1 += 1,
+                Outgoing::Text(_) | Outgoing::Notice(_) | Outgoing::Select(_) => n.1 += 1,
                 Outgoing::Error(_) => n.2 += 1,
                 Outgoing::Done => n.3 += 1,
             }
