@@ -21,7 +21,7 @@ pub struct Cli {
 pub enum Command {
     /// Print counts, face sizes, valences, bounds, colour space and warnings of meshes.
     Info(InfoArgs),
-    /// Convert a mesh (.json, .off, .obj, .svg) to the native JSON format.
+    /// Convert a mesh (.json, .off, .obj, .svg, .pdf, .ai) to the native JSON format.
     Convert(ConvertArgs),
     /// Write the refined control mesh (or its limit points) at a given level.
     Refine(RefineArgs),
@@ -36,7 +36,7 @@ pub enum Command {
 /// Flags of `gradmesh serve`.
 #[derive(Debug, Args)]
 pub struct ServeArgs {
-    /// The document to open (.json, .off, .obj, .svg); without it, a new document. Saving
+    /// The document to open (.json, .off, .obj, .svg, .pdf, .ai); without it, a new document. Saving
     /// writes JSON beside it (the same file if it is JSON).
     pub file: Option<PathBuf>,
     /// The port on 127.0.0.1 (0: any free port).
@@ -91,6 +91,14 @@ impl VariantArgs {
             }
         }
     }
+}
+
+/// The page of a PDF input.
+#[derive(Debug, Args)]
+pub struct PageArg {
+    /// The page of a PDF (or .ai) input to read, from 1.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub page: usize,
 }
 
 /// Limits on the input (`gradmesh::Limits`), raised for trusted input.
@@ -224,9 +232,12 @@ impl From<GamutArg> for GamutMapping {
 /// `gradmesh info`.
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// Input files (.json, .off, .obj, .svg).
+    /// Input files (.json, .off, .obj, .svg, .pdf, .ai).
     #[arg(required = true)]
     pub inputs: Vec<PathBuf>,
+    /// The page of a PDF input.
+    #[command(flatten)]
+    pub page: PageArg,
     /// Limits.
     #[command(flatten)]
     pub limits: LimitArgs,
@@ -245,7 +256,7 @@ pub struct EditsArgs {
 /// `gradmesh convert`.
 #[derive(Debug, Args)]
 pub struct ConvertArgs {
-    /// Input file (.json, .off, .obj, .svg).
+    /// Input file (.json, .off, .obj, .svg, .pdf, .ai).
     pub input: PathBuf,
     /// Output file (.json).
     #[arg(short, long)]
@@ -256,6 +267,9 @@ pub struct ConvertArgs {
     /// The paper's options.
     #[command(flatten)]
     pub variant: VariantArgs,
+    /// The page of a PDF input.
+    #[command(flatten)]
+    pub page: PageArg,
     /// Limits.
     #[command(flatten)]
     pub limits: LimitArgs,
@@ -264,7 +278,7 @@ pub struct ConvertArgs {
 /// `gradmesh refine`.
 #[derive(Debug, Args)]
 pub struct RefineArgs {
-    /// Input file (.json, .off, .obj, .svg).
+    /// Input file (.json, .off, .obj, .svg, .pdf, .ai).
     pub input: PathBuf,
     /// Output file: .obj (`v x y 0 c1 c2 c3` and `f` lines) or .json.
     #[arg(short, long)]
@@ -295,7 +309,7 @@ pub struct RefineArgs {
 /// `gradmesh render`.
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// Input files (.json, .off, .obj, .svg), drawn in order: the first at the bottom.
+    /// Input files (.json, .off, .obj, .svg, .pdf, .ai), drawn in order: the first at the bottom.
     #[arg(required = true)]
     pub inputs: Vec<PathBuf>,
     /// Output file: .png (pixels), .pdf (tensor-product patch shadings) or .svg (mesh
@@ -338,9 +352,10 @@ pub struct RenderArgs {
     /// Gamut mapping of out-of-gamut colours.
     #[arg(long, default_value = "chroma")]
     pub gamut: GamutArg,
-    /// PNG: how the mesh gradients of SVG inputs are drawn, each clipped to its shape:
-    /// `classic` as Inkscape paints them, `scheme` converted into the scheme (the layers
-    /// `convert` writes). PDF and SVG output always take the scheme.
+    /// PNG: how the mesh gradients of SVG inputs and the patch-mesh shadings of PDF inputs are
+    /// drawn, each clipped to its shape: `classic` as Inkscape paints them and as the PDF
+    /// specification defines them, `scheme` converted into the scheme (the layers `convert`
+    /// writes). PDF and SVG output always take the scheme.
     #[arg(long, value_name = "MODE", default_value = "classic")]
     pub svg_mesh: SvgMeshArg,
     /// Slow and simple reference rendering (for checking the fast path).
@@ -386,6 +401,9 @@ pub struct RenderArgs {
     /// The paper's options.
     #[command(flatten)]
     pub variant: VariantArgs,
+    /// The page of a PDF input.
+    #[command(flatten)]
+    pub page: PageArg,
     /// Limits.
     #[command(flatten)]
     pub limits: LimitArgs,

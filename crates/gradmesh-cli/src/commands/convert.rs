@@ -13,7 +13,7 @@ pub fn run(args: &ConvertArgs) -> Result<(), Error> {
         ))));
     }
     super::check_not_input(&args.output, &[&args.input], args.force)?;
-    let mut doc = super::read(&args.input, &args.limits.limits())?;
+    let mut doc = super::read(&args.input, &args.limits.limits(), args.page.page)?;
     args.variant.apply(&mut doc);
     for (i, mesh) in doc.layers.iter().enumerate() {
         let warnings = gradmesh::validate(mesh).map_err(|e| e.in_layer(i).in_file(&args.input))?;

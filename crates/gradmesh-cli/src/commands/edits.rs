@@ -8,7 +8,7 @@ use gradmesh::{ColourEdit, Edit, Error, OpacityEdit};
 use crate::args::EditsArgs;
 
 pub fn run(args: &EditsArgs) -> Result<(), Error> {
-    let doc = super::read(&args.input, &args.limits.limits())?;
+    let doc = super::read(&args.input, &args.limits.limits(), 1)?;
     let mut out = String::new();
     for (i, mesh) in doc.layers.iter().enumerate() {
         let locate = |e: Error| e.in_layer(i).in_file(&args.input);

@@ -16,7 +16,7 @@ pub fn run(args: &InfoArgs) -> Result<(), Failure> {
     let mut failed = 0usize;
     let limits = args.limits.limits();
     for path in &args.inputs {
-        match super::read(path, &limits) {
+        match super::read(path, &limits, args.page.page) {
             Ok(doc) => {
                 println!("{}", path.display());
                 for (i, mesh) in doc.layers.iter().enumerate() {

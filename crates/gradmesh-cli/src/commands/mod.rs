@@ -41,10 +41,10 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
     }
 }
 
-/// Reads a document within `limits`, with errors located in the file. An SVG file's warnings
-/// (what was left out) are printed.
-fn read(path: &Path, limits: &gradmesh::Limits) -> Result<Document, Error> {
-    let input = read_with_viewport(path, limits)?;
+/// Reads a document within `limits` (page `page` of a PDF file), with errors located in the
+/// file. An SVG or PDF file's warnings (what was left out) are printed.
+fn read(path: &Path, limits: &gradmesh::Limits, page: usize) -> Result<Document, Error> {
+    let input = read_with_viewport(path, limits, page)?;
     print_warnings(path, &input.warnings);
     Ok(input.document)
 }
@@ -53,19 +53,47 @@ fn read(path: &Path, limits: &gradmesh::Limits) -> Result<Document, Error> {
 /// (an SVG file's view box and size).
 type Viewport = (gradmesh::render::View, (f64, f64));
 
-/// A file read: its document, and for an SVG file its [`Viewport`] and the mesh-gradient fills
-/// its layers were converted from (one per layer).
+/// What a layer read from an SVG or PDF file was converted from, and is drawn from classically.
+#[derive(Clone, Debug)]
+enum ClassicFill {
+    /// An SVG mesh-gradient fill.
+    Svg(gradmesh::formats::svg::MeshFill),
+    /// A PDF patch-mesh shading.
+    Pdf(gradmesh::formats::pdf::ShadingFill),
+}
+
+/// A file read: its document, and for an SVG or PDF file its [`Viewport`] and the fills its
+/// layers were converted from (one per layer).
 struct Input {
     document: Document,
     viewport: Option<Viewport>,
-    fills: Option<Vec<gradmesh::formats::svg::MeshFill>>,
+    fills: Option<Vec<ClassicFill>>,
     /// What an SVG file held that was left out of `document`, for the caller to print.
     warnings: Vec<gradmesh::Warning>,
 }
 
 /// [`read`], with the file's [`Viewport`] and fills when it has them.
-fn read_with_viewport(path: &Path, limits: &gradmesh::Limits) -> Result<Input, Error> {
-    use gradmesh::formats::{svg, Format};
+fn read_with_viewport(path: &Path, limits: &gradmesh::Limits, page: usize) -> Result<Input, Error> {
+    use gradmesh::formats::{pdf, svg, Format};
+    if gradmesh::formats::is_pdf_path(path) {
+        let read = pdf::read_path_with_limits(path, page, limits)?;
+        let view = read.picture.view_rect();
+        return Ok(Input {
+            document: read.document,
+            viewport: Some((
+                gradmesh::render::View::from_rect(view),
+                (view.width(), view.height()),
+            )),
+            fills: Some(
+                read.picture
+                    .fills
+                    .into_iter()
+                    .map(ClassicFill::Pdf)
+                    .collect(),
+            ),
+            warnings: read.warnings,
+        });
+    }
     if Format::from_path(path) == Some(Format::Svg) {
         let read = svg::read_path_with_limits(path, limits)?;
         let viewport = read
@@ -75,7 +103,7 @@ fn read_with_viewport(path: &Path, limits: &gradmesh::Limits) -> Result<Input, E
         return Ok(Input {
             document: read.document,
             viewport,
-            fills: Some(read.fills),
+            fills: Some(read.fills.into_iter().map(ClassicFill::Svg).collect()),
             warnings: read.warnings,
         });
     }

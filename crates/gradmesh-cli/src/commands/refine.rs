@@ -20,7 +20,7 @@ pub fn run(args: &RefineArgs) -> Result<(), Error> {
         refined_faces: args.max_refined_faces,
         ..args.limits.limits()
     };
-    let mut doc = super::read(&args.input, &limits)?;
+    let mut doc = super::read(&args.input, &limits, 1)?;
     args.variant.apply(&mut doc);
     let points = if args.limit {
         LevelPoints::Limit

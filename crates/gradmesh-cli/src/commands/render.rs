@@ -4,7 +4,6 @@ use std::time::Instant;
 
 use gradmesh::export::{self, ExportOptions};
 use gradmesh::formats;
-use gradmesh::formats::svg::MeshFill;
 use gradmesh::parse_css_colour;
 use gradmesh::render::{
     self, LayerSource, PictureLayer, PngDepth, RenderOptions, SvgMeshRendering, View,
@@ -114,7 +113,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     // What the inputs left out, printed once it is known whether resvg draws it.
     let mut left_out = Vec::new();
     for (k, path) in args.inputs.iter().enumerate() {
-        let read = super::read_with_viewport(path, &limits)?;
+        let read = super::read_with_viewport(path, &limits, args.page.page)?;
         if k == 0 {
             viewport = read.viewport;
         }
@@ -139,7 +138,11 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
 
     let opts = options(args, &doc, viewport)?;
     // A lone SVG input rendered to PNG is drawn whole: resvg draws what is not a mesh fill.
-    let whole = kind == Output::Png && args.inputs.len() == 1 && fills.iter().any(Option::is_some);
+    let whole = kind == Output::Png
+        && args.inputs.len() == 1
+        && fills
+            .iter()
+            .any(|f| matches!(f, Some(super::ClassicFill::Svg(_))));
     if !whole {
         for (path, warnings) in &left_out {
             super::print_warnings(path, warnings);
@@ -255,29 +258,33 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     Ok(())
 }
 
-/// The layers of the picture when an input is an SVG file (`fills[i]` is the fill layer `i` of
-/// `doc` was converted from): its fills clipped to their shapes, drawn as `mode` says, the
-/// other inputs' layers as they are. `None` when no input is an SVG file.
+/// The layers of the picture when an input is an SVG or PDF file (`fills[i]` is the fill
+/// layer `i` of `doc` was converted from): its fills clipped to their shapes, drawn as `mode`
+/// says, the other inputs' layers as they are. `None` when no input is an SVG or PDF file.
 fn picture_layers<'a>(
     doc: &'a Document,
-    fills: &'a [Option<MeshFill>],
+    fills: &'a [Option<super::ClassicFill>],
     mode: SvgMeshRendering,
 ) -> Option<Vec<PictureLayer<'a>>> {
+    use super::ClassicFill;
     fills.iter().any(Option::is_some).then(|| {
         doc.layers
             .iter()
             .zip(fills)
-            .map(|(mesh, fill)| match fill {
-                Some(fill) => render::svg_picture_layers(
-                    std::slice::from_ref(fill),
-                    std::slice::from_ref(mesh),
-                    mode,
-                )
-                .remove(0),
-                None => PictureLayer {
-                    source: LayerSource::Scheme(mesh),
-                    clip: None,
-                },
+            .map(|(mesh, fill)| {
+                let mesh = std::slice::from_ref(mesh);
+                match fill {
+                    Some(ClassicFill::Svg(fill)) => {
+                        render::svg_picture_layers(std::slice::from_ref(fill), mesh, mode).remove(0)
+                    }
+                    Some(ClassicFill::Pdf(fill)) => {
+                        render::pdf_picture_layers(std::slice::from_ref(fill), mesh, mode).remove(0)
+                    }
+                    None => PictureLayer {
+                        source: LayerSource::Scheme(&mesh[0]),
+                        clip: None,
+                    },
+                }
             })
             .collect()
     })

@@ -8,6 +8,7 @@
 pub mod json;
 pub mod obj;
 pub mod off;
+pub mod pdf;
 pub mod svg;
 
 use std::fs;
@@ -104,13 +105,16 @@ pub fn read_path_with_limits(path: &Path, limits: &Limits) -> Result<Document, E
 }
 
 fn read_path_unlocated(path: &Path, limits: &Limits) -> Result<Document, Error> {
+    if is_pdf_path(path) {
+        return pdf::read_path_with_limits(path, 1, limits).map(|read| read.document);
+    }
     let format = Format::from_path(path).ok_or_else(|| {
         let found = match path.extension() {
             Some(ext) => format!("the extension \".{}\"", ext.to_string_lossy()),
             None => "no extension".to_string(),
         };
         Error::new(ErrorKind::UnsupportedFormat(format!(
-            "cannot tell the format from {found}: expected .json, .off, .obj or .svg"
+            "cannot tell the format from {found}: expected .json, .off, .obj, .svg, .pdf or .ai"
         )))
     })?;
     let text = read_text(path, limits.input_bytes)?;
@@ -125,8 +129,30 @@ fn read_path_unlocated(path: &Path, limits: &Limits) -> Result<Document, Error> 
     Ok(doc)
 }
 
+/// Whether `path` names a PDF file by its extension: `.pdf`, or `.ai` (Illustrator files
+/// saved with PDF compatibility), case-insensitive. Such files are read by [`pdf`], page 1
+/// by [`read_path`].
+pub fn is_pdf_path(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("pdf") || e.eq_ignore_ascii_case("ai"))
+}
+
 /// Reads a whole UTF-8 file, refusing one larger than `max_bytes`.
 fn read_text(path: &Path, max_bytes: u64) -> Result<String, Error> {
+    let bytes = read_bytes(path, max_bytes)?;
+    String::from_utf8(bytes).map_err(|e| {
+        let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+        let line = 1 + valid.iter().filter(|&&b| b == b'\n').count();
+        Error {
+            location: Location::default().at_line(line),
+            kind: ErrorKind::Syntax("the file is not UTF-8 text".into()),
+        }
+    })
+}
+
+/// Reads a whole file, refusing one larger than `max_bytes`.
+pub(crate) fn read_bytes(path: &Path, max_bytes: u64) -> Result<Vec<u8>, Error> {
     let io = |e: std::io::Error| Error::new(ErrorKind::Io(format!("cannot read the file: {e}")));
     let file = fs::File::open(path).map_err(io)?;
     let metadata = file.metadata().map_err(io)?;
@@ -145,14 +171,7 @@ fn read_text(path: &Path, max_bytes: u64) -> Result<String, Error> {
         .read_to_end(&mut bytes)
         .map_err(io)?;
     check_size(bytes.len() as u64, max_bytes)?;
-    String::from_utf8(bytes).map_err(|e| {
-        let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
-        let line = 1 + valid.iter().filter(|&&b| b == b'\n').count();
-        Error {
-            location: Location::default().at_line(line),
-            kind: ErrorKind::Syntax("the file is not UTF-8 text".into()),
-        }
-    })
+    Ok(bytes)
 }
 
 /// Refuses an input of `len` bytes above `max_bytes`.

@@ -106,6 +106,7 @@ mod options;
 pub(crate) mod outline;
 mod output;
 mod overlay;
+mod patches;
 mod png_deflate;
 mod quadratic;
 mod stitch;
@@ -263,6 +264,10 @@ pub enum LayerSource<'a> {
     /// with colour bilinear in each patch's parameters in sRGB (smoothed across patches for
     /// `type="bicubic"`).
     Classic(&'a MeshFill),
+    /// A PDF patch-mesh shading (types 6 and 7) painted as the PDF specification defines it:
+    /// tensor-product patches with colour bilinear in each patch's parameters in the shading's
+    /// colour space.
+    Patches(&'a crate::formats::pdf::ShadingFill),
 }
 
 /// One layer of a picture: what it is drawn from, and the outline that clips it.
@@ -307,6 +312,28 @@ pub fn svg_picture_layers<'a>(
         .collect()
 }
 
+/// The layers of a PDF picture: each of `fills` clipped to its clipping path, painted as the
+/// PDF specification defines it, or drawn from its layer of the scheme (`layers[i]` converted
+/// from `fills[i]`, as [`picture_to_document`](crate::formats::pdf::picture_to_document)
+/// makes them) with [`SvgMeshRendering::Scheme`].
+pub fn pdf_picture_layers<'a>(
+    fills: &'a [crate::formats::pdf::ShadingFill],
+    layers: &'a [GradientMesh],
+    mode: SvgMeshRendering,
+) -> Vec<PictureLayer<'a>> {
+    fills
+        .iter()
+        .zip(layers)
+        .map(|(fill, mesh)| PictureLayer {
+            source: match mode {
+                SvgMeshRendering::Classic => LayerSource::Patches(fill),
+                SvgMeshRendering::Scheme => LayerSource::Scheme(mesh),
+            },
+            clip: fill.clip.as_ref().map(|(path, rule)| (path, *rule)),
+        })
+        .collect()
+}
+
 /// Renders the mesh-gradient fills of `scene` into a new `f32` image, each clipped to its
 /// shape, drawn as `mode` says (the scheme's layers with colours in Lab).
 pub fn render_svg_scene(
@@ -344,6 +371,9 @@ pub fn render_picture_into<P: OutputPixel>(
                 LayerSource::Scheme(mesh) => layer::prepare(mesh, i, opts, &xf, &shapes, None)?,
                 LayerSource::Classic(fill) => {
                     classic::prepare(fill, opts, &xf).map_err(|e| e.in_layer(i))?
+                }
+                LayerSource::Patches(fill) => {
+                    patches::prepare(fill, opts, &xf).map_err(|e| e.in_layer(i))?
                 }
             };
             let drawable = drawable.map(|mut d| {

@@ -20,14 +20,14 @@ use palette::{white_point::D65, Lab};
 const ERODE_PX: i64 = 3;
 
 /// An 8-bit RGBA raster.
-struct Raster {
-    width: u32,
-    height: u32,
-    rgba: Vec<[f64; 4]>,
+pub(crate) struct Raster {
+    pub width: u32,
+    pub height: u32,
+    pub rgba: Vec<[f64; 4]>,
 }
 
 impl Raster {
-    fn from_image(image: &Image) -> Raster {
+    pub(crate) fn from_image(image: &Image) -> Raster {
         let rgba = image
             .data
             .chunks(4)
@@ -40,7 +40,7 @@ impl Raster {
         }
     }
 
-    fn read_png(path: &Path) -> Raster {
+    pub(crate) fn read_png(path: &Path) -> Raster {
         let file = std::fs::File::open(path)
             .unwrap_or_else(|e| panic!("cannot open {}: {e}", path.display()));
         let mut decoder = png::Decoder::new(std::io::BufReader::new(file));
@@ -68,7 +68,7 @@ impl Raster {
         }
     }
 
-    fn lab(&self, i: usize) -> [f64; 3] {
+    pub(crate) fn lab(&self, i: usize) -> [f64; 3] {
         let p = self.rgba[i];
         // Over white, for rasters with alpha.
         let c = |k: usize| p[k] * p[3] + (1.0 - p[3]);
@@ -100,7 +100,7 @@ impl Tool {
 
     /// Rasterises `pdf` at 72 dpi (an SVG for Inkscape at 96, its pixel) into a PNG beside it
     /// (with alpha where the tool gives it).
-    fn rasterise(self, pdf: &Path) -> Raster {
+    pub(crate) fn rasterise(self, pdf: &Path) -> Raster {
         let (program, package) = self.program();
         let out = pdf.with_extension(format!("{program}.png"));
         let mut cmd = Command::new(program);

@@ -27,6 +27,7 @@ mod fuzz_replay;
 mod limit_matrix;
 mod opensubdiv_oracle;
 mod options;
+mod pdf_read;
 mod properties;
 mod reference_images;
 mod reference_outputs;

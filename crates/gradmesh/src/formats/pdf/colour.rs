@@ -1,0 +1,300 @@
+//! Colour spaces and functions of shadings: from a shading's components to sRGB.
+
+use crate::colour::{srgb_encode, ColourSpace};
+
+/// The colour spaces a patch-mesh shading may be read in.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PdfColourSpace {
+    /// `DeviceGray` (or `ICCBased` with one component): grey in 0..1, taken as sRGB-encoded.
+    Gray,
+    /// `DeviceRGB` (or `CalRGB`, or `ICCBased` with three components): taken as sRGB.
+    Rgb,
+    /// `DeviceCMYK` (or `ICCBased` with four components), converted naively:
+    /// `R = (1 - C)(1 - K)` and likewise for G with M and B with Y.
+    Cmyk,
+    /// `Lab` with its white point (XYZ, Y = 1): adapted to D65 by the Bradford transform
+    /// when it is not D65, then converted to sRGB.
+    Lab {
+        /// The `WhitePoint`.
+        white: [f64; 3],
+    },
+}
+
+impl PdfColourSpace {
+    /// The number of components of a colour.
+    pub fn components(&self) -> usize {
+        match self {
+            PdfColourSpace::Gray => 1,
+            PdfColourSpace::Rgb | PdfColourSpace::Lab { .. } => 3,
+            PdfColourSpace::Cmyk => 4,
+        }
+    }
+
+    /// The sRGB colour (gamma-encoded, clipped to 0..1) of `c`.
+    pub fn to_srgb(&self, c: &[f64]) -> [f64; 3] {
+        let at = |k: usize| c.get(k).copied().unwrap_or(0.0);
+        let unit = |x: f64| x.clamp(0.0, 1.0);
+        match self {
+            PdfColourSpace::Gray => [unit(at(0)); 3],
+            PdfColourSpace::Rgb => [unit(at(0)), unit(at(1)), unit(at(2))],
+            PdfColourSpace::Cmyk => {
+                let k = unit(at(3));
+                [0, 1, 2].map(|i| (1.0 - unit(at(i))) * (1.0 - k))
+            }
+            PdfColourSpace::Lab { white } => {
+                let linear = lab_to_linear_srgb([at(0), at(1), at(2)], *white);
+                linear.map(|x| srgb_encode(x.clamp(0.0, 1.0)))
+            }
+        }
+    }
+
+    /// Whether the conversion to sRGB is affine, so that colour bilinear in the components is
+    /// bilinear in sRGB.
+    pub fn is_affine(&self) -> bool {
+        matches!(self, PdfColourSpace::Gray | PdfColourSpace::Rgb)
+    }
+}
+
+/// The D65 white point as the Lab space of this crate takes it.
+const D65: [f64; 3] = [0.95047, 1.0, 1.08883];
+
+/// Linear sRGB of CIE Lab relative to `white`.
+fn lab_to_linear_srgb(lab: [f64; 3], white: [f64; 3]) -> [f64; 3] {
+    let near_d65 = white.iter().zip(D65).all(|(a, b)| (a - b).abs() < 2e-3);
+    if near_d65 {
+        return ColourSpace::Lab.to_linear_srgb(lab);
+    }
+    let finv = |t: f64| {
+        if t > 6.0 / 29.0 {
+            t * t * t
+        } else {
+            3.0 * (6.0f64 / 29.0).powi(2) * (t - 4.0 / 29.0)
+        }
+    };
+    let l = (lab[0] + 16.0) / 116.0;
+    let xyz = [
+        white[0] * finv(l + lab[1] / 500.0),
+        white[1] * finv(l),
+        white[2] * finv(l - lab[2] / 200.0),
+    ];
+    let adapted = bradford(xyz, white, D65);
+    // XYZ (D65) to linear sRGB.
+    const M: [[f64; 3]; 3] = [
+        [3.2404542, -1.5371385, -0.4985314],
+        [-0.9692660, 1.8760108, 0.0415560],
+        [0.0556434, -0.2040259, 1.0572252],
+    ];
+    M.map(|row| row[0] * adapted[0] + row[1] * adapted[1] + row[2] * adapted[2])
+}
+
+/// `xyz` under white `from` adapted to white `to` by the Bradford transform.
+fn bradford(xyz: [f64; 3], from: [f64; 3], to: [f64; 3]) -> [f64; 3] {
+    const B: [[f64; 3]; 3] = [
+        [0.8951, 0.2664, -0.1614],
+        [-0.7502, 1.7135, 0.0367],
+        [0.0389, -0.0685, 1.0296],
+    ];
+    const B_INV: [[f64; 3]; 3] = [
+        [0.9869929, -0.1470543, 0.1599627],
+        [0.4323053, 0.5183603, 0.0492912],
+        [-0.0085287, 0.0400428, 0.9684867],
+    ];
+    let mul = |m: &[[f64; 3]; 3], v: [f64; 3]| m.map(|r| r[0] * v[0] + r[1] * v[1] + r[2] * v[2]);
+    let (cone, cf, ct) = (mul(&B, xyz), mul(&B, from), mul(&B, to));
+    let scaled = [0, 1, 2].map(|k| {
+        if cf[k].abs() > 1e-12 {
+            cone[k] * ct[k] / cf[k]
+        } else {
+            cone[k]
+        }
+    });
+    mul(&B_INV, scaled)
+}
+
+/// A PDF function of one input (types 0, 2 and 3), or several of one output each.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Function {
+    /// Type 0: samples over the domain, interpolated linearly.
+    Sampled {
+        /// `Domain`.
+        domain: [f64; 2],
+        /// `Encode` of the input, into `0..size - 1`.
+        encode: [f64; 2],
+        /// The number of samples.
+        size: usize,
+        /// The outputs, `size` rows of the output count, already decoded.
+        samples: Vec<f64>,
+        /// The number of outputs.
+        outputs: usize,
+    },
+    /// Type 2: `C0 + x^N (C1 - C0)`.
+    Exponential {
+        /// `Domain`.
+        domain: [f64; 2],
+        /// `C0`.
+        c0: Vec<f64>,
+        /// `C1`.
+        c1: Vec<f64>,
+        /// `N`.
+        n: f64,
+    },
+    /// Type 3: functions over the parts of the domain `Bounds` cut it into.
+    Stitching {
+        /// `Domain`.
+        domain: [f64; 2],
+        /// The functions, one per part.
+        functions: Vec<Function>,
+        /// `Bounds`.
+        bounds: Vec<f64>,
+        /// `Encode`, a pair per function.
+        encode: Vec<[f64; 2]>,
+    },
+    /// An array of functions of one output each: the outputs side by side.
+    Array(Vec<Function>),
+}
+
+impl Function {
+    /// The outputs at `x` (clipped to the domain).
+    pub fn eval(&self, x: f64) -> Vec<f64> {
+        let clip = |x: f64, d: [f64; 2]| x.clamp(d[0].min(d[1]), d[0].max(d[1]));
+        let interpolate = |x: f64, from: [f64; 2], to: [f64; 2]| {
+            if from[1] == from[0] {
+                to[0]
+            } else {
+                to[0] + (x - from[0]) * (to[1] - to[0]) / (from[1] - from[0])
+            }
+        };
+        match self {
+            Function::Sampled {
+                domain,
+                encode,
+                size,
+                samples,
+                outputs,
+            } => {
+                let e = interpolate(clip(x, *domain), *domain, *encode);
+                let e = e.clamp(0.0, (*size - 1) as f64);
+                let i0 = (e.floor() as usize).min(size - 1);
+                let i1 = (i0 + 1).min(size - 1);
+                let t = e - i0 as f64;
+                (0..*outputs)
+                    .map(|k| samples[i0 * outputs + k] * (1.0 - t) + samples[i1 * outputs + k] * t)
+                    .collect()
+            }
+            Function::Exponential { domain, c0, c1, n } => {
+                let x = clip(x, *domain);
+                let p = if *n == 1.0 { x } else { x.max(0.0).powf(*n) };
+                c0.iter().zip(c1).map(|(a, b)| a + p * (b - a)).collect()
+            }
+            Function::Stitching {
+                domain,
+                functions,
+                bounds,
+                encode,
+            } => {
+                let x = clip(x, *domain);
+                let k = bounds.iter().take_while(|&&b| x >= b).count();
+                let k = k.min(functions.len() - 1);
+                let lo = if k == 0 { domain[0] } else { bounds[k - 1] };
+                let hi = if k == bounds.len() {
+                    domain[1]
+                } else {
+                    bounds[k]
+                };
+                functions[k].eval(interpolate(x, [lo, hi], encode[k]))
+            }
+            Function::Array(functions) => functions
+                .iter()
+                .flat_map(|f| f.eval(x).into_iter().take(1))
+                .collect(),
+        }
+    }
+}
+
+/// How a shading's corner components become colours: its colour space, and the function of
+/// the parametric value when it has one.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShadingColour {
+    /// The `ColorSpace`.
+    pub space: PdfColourSpace,
+    /// The `Function`: each corner then has one parametric value `t`.
+    pub function: Option<Function>,
+}
+
+impl ShadingColour {
+    /// The number of components each corner carries.
+    pub fn corner_components(&self) -> usize {
+        match self.function {
+            Some(_) => 1,
+            None => self.space.components(),
+        }
+    }
+
+    /// The sRGB colour (gamma-encoded, 0..1) of the corner components `c`.
+    pub fn to_srgb(&self, c: &[f64]) -> [f64; 3] {
+        match &self.function {
+            Some(f) => self
+                .space
+                .to_srgb(&f.eval(c.first().copied().unwrap_or(0.0))),
+            None => self.space.to_srgb(c),
+        }
+    }
+
+    /// Whether colour bilinear in the components is bilinear in sRGB.
+    pub fn is_affine(&self) -> bool {
+        self.function.is_none() && self.space.is_affine()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn naive_cmyk_and_grey() {
+        let cmyk = PdfColourSpace::Cmyk;
+        assert_eq!(cmyk.to_srgb(&[1.0, 0.0, 0.0, 0.0]), [0.0, 1.0, 1.0]);
+        assert_eq!(cmyk.to_srgb(&[0.0, 0.0, 0.0, 0.5]), [0.5, 0.5, 0.5]);
+        assert_eq!(PdfColourSpace::Gray.to_srgb(&[0.25]), [0.25; 3]);
+    }
+
+    /// Lab under D50 white is adapted: its white is sRGB white, as D65 white is.
+    #[test]
+    fn lab_white_points() {
+        let d50 = PdfColourSpace::Lab {
+            white: [0.9642, 1.0, 0.8249],
+        };
+        let d65 = PdfColourSpace::Lab { white: D65 };
+        for space in [d50, d65] {
+            let white = space.to_srgb(&[100.0, 0.0, 0.0]);
+            assert!(white.iter().all(|&c| (c - 1.0).abs() < 2e-3), "{white:?}");
+            let grey = space.to_srgb(&[50.0, 0.0, 0.0]);
+            assert!((grey[0] - grey[2]).abs() < 2e-3, "{grey:?}");
+        }
+    }
+
+    #[test]
+    fn stitched_exponential_functions() {
+        let red_green = Function::Exponential {
+            domain: [0.0, 1.0],
+            c0: vec![1.0, 0.0, 0.0],
+            c1: vec![0.0, 1.0, 0.0],
+            n: 1.0,
+        };
+        let green_blue = Function::Exponential {
+            domain: [0.0, 1.0],
+            c0: vec![0.0, 1.0, 0.0],
+            c1: vec![0.0, 0.0, 1.0],
+            n: 1.0,
+        };
+        let f = Function::Stitching {
+            domain: [0.0, 1.0],
+            functions: vec![red_green, green_blue],
+            bounds: vec![0.5],
+            encode: vec![[0.0, 1.0], [0.0, 1.0]],
+        };
+        assert_eq!(f.eval(0.25), vec![0.5, 0.5, 0.0]);
+        assert_eq!(f.eval(0.75), vec![0.0, 0.5, 0.5]);
+        assert_eq!(f.eval(2.0), vec![0.0, 0.0, 1.0]);
+    }
+}

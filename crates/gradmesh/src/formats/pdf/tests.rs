@@ -1,0 +1,230 @@
+//! PDF files written by hand: what is read from them, and clear errors on hostile ones.
+
+use kurbo::Point;
+
+use super::*;
+
+/// A PDF file of the given objects (numbered from 1; object 1 is the catalog), with a correct
+/// cross-reference table, and `trailer_extra` added to the trailer.
+fn pdf_file(objects: &[Vec<u8>], trailer_extra: &str) -> Vec<u8> {
+    let mut out = b"%PDF-1.7\n".to_vec();
+    let mut offsets = Vec::new();
+    for (k, body) in objects.iter().enumerate() {
+        offsets.push(out.len());
+        out.extend(format!("{} 0 obj\n", k + 1).as_bytes());
+        out.extend(body);
+        out.extend(b"\nendobj\n");
+    }
+    let xref = out.len();
+    out.extend(format!("xref\n0 {}\n0000000000 65535 f \n", objects.len() + 1).as_bytes());
+    for o in offsets {
+        out.extend(format!("{o:010} 00000 n \n").as_bytes());
+    }
+    out.extend(
+        format!(
+            "trailer\n<< /Size {} /Root 1 0 R {trailer_extra} >>\nstartxref\n{xref}\n%%EOF\n",
+            objects.len() + 1
+        )
+        .as_bytes(),
+    );
+    out
+}
+
+fn stream(dict: &str, data: &[u8]) -> Vec<u8> {
+    let mut s = format!("<< {dict} /Length {} >>\nstream\n", data.len()).into_bytes();
+    s.extend(data);
+    s.extend(b"\nendstream");
+    s
+}
+
+/// One type 6 patch over (0, 0)-(255, 255), 8-bit everything, flag 0, corners red, green,
+/// blue, white (stream order c00, c03, c33, c30).
+fn coons_record() -> Vec<u8> {
+    let mut data = vec![0u8];
+    let points: [(u8, u8); 12] = [
+        (0, 0),
+        (0, 85),
+        (0, 170),
+        (0, 255),
+        (85, 255),
+        (170, 255),
+        (255, 255),
+        (255, 170),
+        (255, 85),
+        (255, 0),
+        (170, 0),
+        (85, 0),
+    ];
+    data.extend(points.iter().flat_map(|&(x, y)| [x, y]));
+    data.extend([255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255]);
+    data
+}
+
+const SHADING_DICT: &str = "/ShadingType 6 /ColorSpace /DeviceRGB /BitsPerCoordinate 8 /BitsPerComponent 8 /BitsPerFlag 8 /Decode [0 255 0 255 0 1 0 1 0 1]";
+
+/// A page of 300 x 200 points painting object 5 (a shading) with `content`.
+fn page_with(content: &str, shading: Vec<u8>, more: Vec<Vec<u8>>) -> Vec<u8> {
+    let mut objects = vec![
+        b"<< /Type /Catalog /Pages 2 0 R >>".to_vec(),
+        b"<< /Type /Pages /Kids [3 0 R] /Count 1 >>".to_vec(),
+        b"<< /Type /Page /Parent 2 0 R /MediaBox [0 0 300 200] /Contents 4 0 R /Resources << /Shading << /S0 5 0 R >> /Pattern << /P0 6 0 R >> >> >>".to_vec(),
+        stream("", content.as_bytes()),
+        shading,
+        b"<< /PatternType 2 /Shading 5 0 R /Matrix [1 0 0 1 10 20] >>".to_vec(),
+    ];
+    objects.extend(more);
+    pdf_file(&objects, "")
+}
+
+#[test]
+fn a_coons_patch_painted_by_sh_is_read_in_picture_units() {
+    let file = page_with(
+        "q 1 0 0 1 5 -10 cm /S0 sh Q",
+        stream(SHADING_DICT, &coons_record()),
+        vec![],
+    );
+    let picture = read_pdf(&file, 1, &Limits::DEFAULT).unwrap();
+    assert_eq!((picture.page, picture.pages), (1, 1));
+    assert_eq!(picture.view_rect(), Rect::new(0.0, 0.0, 300.0, 200.0));
+    let fill = &picture.fills[0];
+    assert_eq!((fill.object.as_str(), fill.shading_type), ("object 5", 6));
+    assert!(fill.clip.is_none(), "{:?}", fill.clip);
+    let p = &fill.patches[0];
+    // (0, 0) in shading space, moved by (5, -10), then y flipped in the 200 pt page.
+    assert_eq!(p.points[0][0], Point::new(5.0, 210.0));
+    assert_eq!(p.points[3][3], Point::new(260.0, -45.0));
+    assert_eq!(fill.srgb_at(p, 0.0, 0.0), [1.0, 0.0, 0.0]);
+    assert_eq!(fill.srgb_at(p, 0.0, 1.0), [0.0, 1.0, 0.0]);
+    assert_eq!(fill.srgb_at(p, 1.0, 1.0), [0.0, 0.0, 1.0]);
+    assert_eq!(fill.srgb_at(p, 1.0, 0.0), [1.0, 1.0, 1.0]);
+    // One layer of one face with its four points.
+    let (doc, _) = picture_to_document(&picture, ColourSpace::Lab);
+    assert_eq!(
+        (doc.layers[0].points.len(), doc.layers[0].faces.len()),
+        (4, 1)
+    );
+}
+
+#[test]
+fn a_pattern_fill_is_clipped_to_its_path_and_placed_by_the_pattern_matrix() {
+    let content = "/Pattern cs /P0 scn 0 0 100 50 re f";
+    let file = page_with(content, stream(SHADING_DICT, &coons_record()), vec![]);
+    let picture = read_pdf(&file, 1, &Limits::DEFAULT).unwrap();
+    let fill = &picture.fills[0];
+    assert_eq!(fill.patches[0].points[0][0], Point::new(10.0, 180.0));
+    let (clip, _) = fill.clip.as_ref().expect("the filled rectangle clips");
+    let b = kurbo::Shape::bounding_box(clip);
+    assert_eq!((b.x0, b.y0, b.x1, b.y1), (0.0, 150.0, 100.0, 200.0));
+}
+
+#[test]
+fn a_function_gives_the_colour_of_the_parametric_value() {
+    let mut data = vec![0u8];
+    data.extend(coons_record()[1..25].iter());
+    data.extend([0, 255, 255, 0]);
+    let dict = "/ShadingType 6 /ColorSpace /DeviceRGB /BitsPerCoordinate 8 /BitsPerComponent 8 /BitsPerFlag 8 /Decode [0 255 0 255 0 1] /Function << /FunctionType 2 /Domain [0 1] /C0 [1 0 0] /C1 [0 0 1] /N 1 >>";
+    let file = page_with("/S0 sh", stream(dict, &data), vec![]);
+    let picture = read_pdf(&file, 1, &Limits::DEFAULT).unwrap();
+    let fill = &picture.fills[0];
+    let p = &fill.patches[0];
+    assert_eq!(fill.srgb_at(p, 0.0, 0.0), [1.0, 0.0, 0.0]);
+    // Halfway along v at u = 0: t = 0.5, half red and half blue.
+    assert_eq!(fill.srgb_at(p, 0.0, 0.5), [0.5, 0.0, 0.5]);
+}
+
+/// The message of reading `file`'s page 1, which must fail.
+fn error_of(file: &[u8]) -> String {
+    read_pdf(file, 1, &Limits::DEFAULT).unwrap_err().to_string()
+}
+
+#[test]
+fn hostile_files_are_clear_errors() {
+    // Truncated shading stream: the record stops half way.
+    let short = &coons_record()[..20];
+    let e = error_of(&page_with("/S0 sh", stream(SHADING_DICT, short), vec![]));
+    assert!(
+        e.contains("object 5") && e.contains("ends inside the patch"),
+        "{e}"
+    );
+    // A Decode array of the wrong length.
+    let dict = SHADING_DICT.replace("0 1 0 1 0 1]", "0 1]");
+    let e = error_of(&page_with("/S0 sh", stream(&dict, &coons_record()), vec![]));
+    assert!(
+        e.contains("object 5 /Decode") && e.contains("expected 10 numbers"),
+        "{e}"
+    );
+    // A bit width the format does not have.
+    let dict = SHADING_DICT.replace("/BitsPerCoordinate 8", "/BitsPerCoordinate 7");
+    let e = error_of(&page_with("/S0 sh", stream(&dict, &coons_record()), vec![]));
+    assert!(
+        e.contains("BitsPerCoordinate") && e.contains("7 is not one of"),
+        "{e}"
+    );
+    // A reference loop: the shading's colour space refers to itself.
+    let dict = SHADING_DICT.replace("/ColorSpace /DeviceRGB", "/ColorSpace 7 0 R");
+    let e = error_of(&page_with(
+        "/S0 sh",
+        stream(&dict, &coons_record()),
+        vec![b"8 0 R".to_vec(), b"7 0 R".to_vec()],
+    ));
+    assert!(e.contains("loop"), "{e}");
+    // Absurd patch counts: more than the limit allows, refused before they are read.
+    let limits = Limits {
+        faces: 3,
+        ..Limits::DEFAULT
+    };
+    let many: Vec<u8> = coons_record().repeat(10);
+    let file = page_with("/S0 sh", stream(SHADING_DICT, &many), vec![]);
+    let e = read_pdf(&file, 1, &limits).unwrap_err().to_string();
+    assert!(e.contains("above the limit of 3"), "{e}");
+    // A form that draws itself.
+    let form = stream(
+        "/Type /XObject /Subtype /Form /BBox [0 0 10 10] /Resources << /XObject << /F 7 0 R >> >>",
+        b"/F Do",
+    );
+    let file = page_with(
+        "/F Do",
+        stream(SHADING_DICT, &coons_record()),
+        vec![form.clone(), form],
+    );
+    let file = String::from_utf8_lossy(&file).replace(
+        "/Pattern << /P0 6 0 R >>",
+        "/Pattern << /P0 6 0 R >> /XObject << /F 7 0 R >>",
+    );
+    let e = error_of(file.as_bytes());
+    assert!(
+        e.contains("draws itself") || e.contains("deeper than"),
+        "{e}"
+    );
+    // Not a PDF, and a page that is not there.
+    assert!(error_of(b"hello").contains("not a PDF file"));
+    let file = page_with("/S0 sh", stream(SHADING_DICT, &coons_record()), vec![]);
+    let e = read_pdf(&file, 2, &Limits::DEFAULT)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("1 page; there is no page 2"), "{e}");
+}
+
+#[test]
+fn an_encrypted_file_is_refused() {
+    let file = pdf_file(
+        &[
+            b"<< /Type /Catalog /Pages 2 0 R >>".to_vec(),
+            b"<< /Type /Pages /Kids [] /Count 0 >>".to_vec(),
+            b"<< /Filter /Standard /V 1 /R 2 /O <00> /U <00> /P -4 >>".to_vec(),
+        ],
+        "/Encrypt 3 0 R /ID [<00112233445566778899aabbccddeeff> <00112233445566778899aabbccddeeff>]",
+    );
+    let e = error_of(&file);
+    assert!(
+        e.to_lowercase().contains("encrypt") || e.contains("password"),
+        "{e}"
+    );
+}
+
+#[test]
+fn ai_files_are_pdf_inside() {
+    assert!(is_pdf(b"%!PS-Adobe\n%PDF-1.5\n"));
+    assert!(!is_pdf(b"<svg/>"));
+    assert!(crate::formats::is_pdf_path(std::path::Path::new("x.AI")));
+}
