@@ -259,14 +259,18 @@ fn de_casteljau(c: &[Point; 4], t: f64) -> Point {
     l(e, f)
 }
 
+/// A side by the bits of its four points.
+type SideKey = [(u64, u64); 4];
+/// A side of a patch: `(patch, side)`.
+type SideOf = (usize, usize);
+
 /// The sides `(patch, side)` on the mesh's outline: every side but those that two patches run
 /// in opposite directions (shared by neighbours of the same orientation), each run the way
 /// that gives every patch the same orientation.
 fn outer_sides(patches: &[PixelPatch]) -> Vec<(usize, usize)> {
     let bits = |s: &[Point; 4]| s.map(|p| (p.x.to_bits(), p.y.to_bits()));
     // Sides keyed by their points from the lesser end, with the count of each direction.
-    let mut seen: HashMap<[(u64, u64); 4], (Vec<(usize, usize)>, Vec<(usize, usize)>)> =
-        HashMap::new();
+    let mut seen: HashMap<SideKey, (Vec<SideOf>, Vec<SideOf>)> = HashMap::new();
     for (p, patch) in patches.iter().enumerate() {
         for (s, side) in patch.sides.iter().enumerate() {
             let forward = bits(side);

@@ -131,7 +131,7 @@ impl<'a> Interpreter<'a> {
                 }
                 "cm" => {
                     let m = nums(6)?;
-                    state.ctm = state.ctm * Affine::new([m[0], m[1], m[2], m[3], m[4], m[5]]);
+                    state.ctm *= Affine::new([m[0], m[1], m[2], m[3], m[4], m[5]]);
                 }
                 "m" | "l" | "c" | "v" | "y" | "h" | "re" => {
                     let operands = nums(operand_count(&op.operator))?;

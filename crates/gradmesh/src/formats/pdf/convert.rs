@@ -80,7 +80,7 @@ pub fn fill_to_layer(fill: &ShadingFill, space: ColourSpace) -> (GradientMesh, V
         };
         // Around the patch: (0, 0), (0, 1), (1, 1), (1, 0), with the sides between them.
         let p = &patch.points;
-        let mut corners = vec![
+        let mut corners = [
             (p[0][0], colour_at(0)),
             (p[0][3], colour_at(1)),
             (p[3][3], colour_at(3)),
