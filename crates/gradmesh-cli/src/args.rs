@@ -36,9 +36,11 @@ pub enum Command {
 /// Flags of `gradmesh serve`.
 #[derive(Debug, Args)]
 pub struct ServeArgs {
-    /// The document to open (.json, .off, .obj, .svg, .pdf, .ai); without it, a new document. Saving
-    /// writes JSON beside it (the same file if it is JSON).
-    pub file: Option<PathBuf>,
+    /// The documents to open (.json, .off, .obj, .svg, .pdf, .ai), their layers in order, the first at
+    /// the bottom; without any, a new document. Saving writes JSON beside the one file (the
+    /// same file if it is JSON); several files are saved with "Save as".
+    #[arg(value_name = "FILE")]
+    pub files: Vec<PathBuf>,
     /// The port on 127.0.0.1 (0: any free port).
     #[arg(long, default_value_t = 0)]
     pub port: u16,

@@ -259,7 +259,7 @@ function drawOverlay() {
   c.setTransform(size.ratio, 0, 0, size.ratio, 0, 0);
   c.clearRect(0, 0, size.cssWidth, size.cssHeight);
   const layer = activeLayer();
-  if (!layer || !editor.view || layer.hidden) { drawBox(c); return; }
+  if (!layer || !editor.view || !meshShown(editor.activeLayer)) { drawBox(c); return; }
   if (editor.face !== null && layer.faces[editor.face]) {
     const corners = layer.faces[editor.face];
     c.beginPath();
@@ -401,17 +401,6 @@ function pickPoint(layer, sx, sy) {
   return best;
 }
 
-function pickHandle(layer, sx, sy) {
-  for (const p of editor.selection) {
-    for (const [from, to] of layer.handles) {
-      if (from !== p) continue;
-      const [hx, hy] = handleEnd(layer, from, to);
-      if (Math.hypot(hx - sx, hy - sy) < 7) return [from, to];
-    }
-  }
-  return null;
-}
-
 function pickEdge(layer, sx, sy) {
   let best = null, bestDistance = 6;
   for (const [a, b] of layer.edges) {
@@ -461,9 +450,11 @@ overlay.addEventListener("pointerdown", (event) => {
     editor.drag = { kind: "pan", start: at, view: { ...editor.view } };
     return;
   }
+  if (editor.preview) return;
   if (editor.tools && editor.tools.pointerDown(event, at)) return;
+  activateLayerWithPointUnder(...at);
   const layer = activeLayer();
-  if (!layer || layer.hidden) return;
+  if (!layer || !meshShown(editor.activeLayer)) return;
   const refined = pickRefined(...at);
   if (refined) {
     editor.refined.chosen = refined;
@@ -477,13 +468,14 @@ overlay.addEventListener("pointerdown", (event) => {
     drawOverlay();
     return;
   }
-  const handle = pickHandle(layer, ...at);
-  if (handle) {
+  const picked = pickPress(layer, ...at);
+  if (picked && picked.handle) {
+    const handle = picked.handle;
     editor.drag = { kind: "handle", handle, start: at, gesture: editor.nextGesture++,
       origin: handleOf(layer, ...handle) };
     return;
   }
-  const point = pickPoint(layer, ...at);
+  const point = picked ? picked.point : null;
   if (point !== null) {
     if (event.shiftKey) {
       editor.selection = editor.selection.includes(point)
@@ -558,6 +550,7 @@ overlay.addEventListener("pointerup", (event) => {
 
 // A box drag selects the points inside; a click on nothing selects the edge or face under it.
 function finishBox(d, at) {
+  if (Math.abs(at[0] - d.start[0]) < 3 && Math.abs(at[1] - d.start[1]) < 3) activateLayerWithFaceUnder(...at);
   const layer = activeLayer();
   const [x0, x1] = [Math.min(d.start[0], at[0]), Math.max(d.start[0], at[0])];
   const [y0, y1] = [Math.min(d.start[1], at[1]), Math.max(d.start[1], at[1])];
@@ -585,12 +578,12 @@ overlay.addEventListener("wheel", (event) => {
 
 window.addEventListener("keyup", (event) => { if (event.key === " ") spaceDown = false; });
 window.addEventListener("keydown", (event) => {
-  if (event.target.tagName === "INPUT" || event.target.tagName === "SELECT") return;
+  if (takeKey(event)) return;
+  if (isTextField(event.target)) return;
   const ctrl = event.ctrlKey || event.metaKey;
   const key = event.key.toLowerCase();
   if (ctrl && key === "z") { send({ type: event.shiftKey ? "redo" : "undo" }); }
   else if (ctrl && key === "y") { send({ type: "redo" }); }
-  else if (ctrl && key === "s") { save(); }
   else if (ctrl) { return; }
   else if (editor.tools && editor.tools.key(event, key)) { /* a tool's key (tools.js) */ }
   else if (event.key === " ") { spaceDown = true; }
@@ -822,7 +815,10 @@ async function refreshFiles() {
 function updatePanels() {
   const state = editor.state;
   if (!state) return;
+  activateImported(state);
+  selectPasted(state);
   showFileState(state);
+  showRecovery(state);
   $("undo").disabled = !state.can_undo;
   $("redo").disabled = !state.can_redo;
   updateLayerList(state);
@@ -863,7 +859,7 @@ function updateLayerList(state) {
     };
     const name = document.createElement("span");
     name.textContent = `${layer.name || "unnamed"} (${layer.points.length} points, ${layer.space})`;
-    item.append(shown, name);
+    item.append(shown, meshToggle(i), name);
     item.onclick = () => { editor.activeLayer = i; editor.selection = []; editor.edge = null; editor.face = null; updatePanels(); drawOverlay(); };
     list.append(item);
   });

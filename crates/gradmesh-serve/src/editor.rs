@@ -77,6 +77,21 @@ impl History {
         Ok(applied)
     }
 
+    /// Replaces the whole picture as one step (a recovery copy restored, layers imported),
+    /// if every layer passes the validator.
+    pub fn replace(&mut self, picture: Picture) -> Result<(), String> {
+        check_picture(&picture, None)?;
+        self.undo
+            .push(std::mem::replace(&mut self.current, picture));
+        if self.undo.len() > MAX_HISTORY {
+            self.undo.remove(0);
+        }
+        self.redo.clear();
+        self.gesture = None;
+        self.version += 1;
+        Ok(())
+    }
+
     /// Ends the open gesture: the next edit starts a new step.
     pub fn end_gesture(&mut self) {
         self.gesture = None;

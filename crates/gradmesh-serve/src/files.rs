@@ -1,5 +1,6 @@
 //! What keeps the user's work: saving without replacing a file the session did not write
-//! unless asked to, and what the page is told about the file (its name, the last save).
+//! unless asked to, the recovery copy ([`crate::recovery`]), layers imported from files, and
+//! what the page is told about them (the file's name, the last save, a copy to restore).
 
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -8,11 +9,19 @@ use std::time::{SystemTime, UNIX_EPOCH};
 use axum::http::StatusCode;
 use serde_json::{json, Value};
 
+use gradmesh::GradientMesh;
+
 use crate::editor::Editor;
+use crate::ops::Picture;
+use crate::recovery::Recovery;
 use crate::security::Folder;
 
 /// The code of the error refusing to replace a file the session did not write.
 pub const FILE_EXISTS: &str = "file_exists";
+
+/// The code of the error refusing edits while a recovery copy waits to be restored or
+/// discarded.
+pub const RECOVERY_PENDING: &str = "recovery_pending";
 
 /// A command refused: the message for the user and, for refusals the page answers by asking
 /// the user, a code naming the question.
@@ -51,7 +60,7 @@ pub fn status_of_error(text: &str) -> StatusCode {
         .ok()
         .and_then(|v| v["code"].as_str().map(str::to_owned));
     match code.as_deref() {
-        Some(FILE_EXISTS) => StatusCode::CONFLICT,
+        Some(FILE_EXISTS | RECOVERY_PENDING) => StatusCode::CONFLICT,
         _ => StatusCode::UNPROCESSABLE_ENTITY,
     }
 }
@@ -67,6 +76,11 @@ pub struct FileState {
     last_save: Option<(String, u64)>,
     /// Changes whenever what the page is told about the files changes.
     generation: u64,
+    /// The recovery copy of the document.
+    pub recovery: Recovery,
+    /// What a document without a file was made from (the folder and the files opened), which
+    /// names its recovery copy.
+    key: String,
 }
 
 impl FileState {
@@ -76,8 +90,10 @@ impl FileState {
     }
 
     /// Notes that `editor` was just opened from `source` (or made new, without one): the
-    /// source may be replaced if the document is saved to it, and no save is reported yet.
-    pub fn opened(&mut self, source: Option<&Path>, editor: &Editor) {
+    /// source may be replaced if the document is saved to it, no save is reported yet, and
+    /// the recovery copy follows the document (`key`: what a document without a file was
+    /// made from). Returns a message if a recovery copy there cannot be read.
+    pub fn opened(&mut self, source: Option<&Path>, editor: &Editor, key: &str) -> Option<String> {
         if let (Some(source), Some(path)) = (source, &editor.path) {
             if source == path {
                 self.replaceable.insert(path.clone());
@@ -85,6 +101,49 @@ impl FileState {
         }
         self.last_save = None;
         self.generation += 1;
+        self.key = key.to_string();
+        self.recovery.attach(editor.path.as_deref(), key)
+    }
+
+    /// Turns recovery copies on (`state_dir`: the folder for documents without a file) and
+    /// looks for a copy of `editor`'s document. Returns a message if one cannot be read.
+    pub fn enable_recovery(
+        &mut self,
+        state_dir: Option<PathBuf>,
+        editor: &Editor,
+    ) -> Option<String> {
+        self.recovery.enable(state_dir);
+        self.generation += 1;
+        let key = self.key.clone();
+        self.recovery.attach(editor.path.as_deref(), &key)
+    }
+
+    /// Whether a recovery copy waits for the user's choice.
+    pub fn recovery_pending(&self) -> bool {
+        self.recovery.found().is_some()
+    }
+
+    /// Restores the recovery copy into `editor` (one step of the history, so undo goes back
+    /// to the file), or discards it.
+    pub fn choose_recovery(&mut self, editor: &mut Editor, restore: bool) -> Result<(), String> {
+        if !self.recovery_pending() {
+            return Err("there is no recovery copy to restore or discard".into());
+        }
+        self.generation += 1;
+        if restore {
+            let doc = self.recovery.take_found().expect("pending");
+            editor.history.replace(Picture::new(doc))
+        } else {
+            self.recovery.discard_found()
+        }
+    }
+}
+
+/// The refusal of an edit while a recovery copy waits.
+pub fn recovery_pending_refusal() -> Refusal {
+    Refusal {
+        message: "a recovery copy of unsaved edits waits: restore or discard it first".into(),
+        code: Some(RECOVERY_PENDING),
     }
 }
 
@@ -112,14 +171,53 @@ pub fn save(
     files.replaceable.insert(path.to_path_buf());
     files.last_save = Some((name, unix_millis()));
     files.generation += 1;
+    let key = files.key.clone();
+    files.recovery.saved(path, &key)?;
     Ok(())
 }
 
+/// The layers of the document in `path`, named after the file where they have no name.
+pub fn read_layers(path: &Path) -> Result<Vec<GradientMesh>, String> {
+    let doc = gradmesh::formats::read_path(path).map_err(|e| e.to_string())?;
+    let stem = path.file_stem().map(|s| s.to_string_lossy().to_string());
+    let count = doc.layers.len();
+    let layers = doc.layers.into_iter().enumerate().map(|(i, mut layer)| {
+        if layer.name.is_none() {
+            layer.name = match (&stem, count) {
+                (Some(stem), 1) => Some(stem.clone()),
+                (Some(stem), _) => Some(format!("{stem} {}", i + 1)),
+                (None, _) => None,
+            };
+        }
+        layer
+    });
+    Ok(layers.collect())
+}
+
+/// Adds the layers of the document `name` (a file of the folder, any format gradmesh reads)
+/// above the layers of `editor`'s document, as one step of the history.
+pub fn import_layers(folder: &Folder, editor: &mut Editor, name: &str) -> Result<(), String> {
+    let path = folder.resolve(name)?;
+    let layers = read_layers(&path)?;
+    if layers.is_empty() {
+        return Err(format!("{name} has no layers"));
+    }
+    let mut next = editor.history.current().clone();
+    next.hidden.extend(layers.iter().map(|_| false));
+    next.doc.layers.extend(layers);
+    editor.history.replace(next)
+}
+
 /// Adds what the page shows of the files to the state message `state`: `saved` (the file and
-/// the time of the last save, or null).
+/// the time of the last save, or null) and `recovery` (the recovery copy waiting for the
+/// user's choice: its path and time, or null).
 pub fn describe(files: &FileState, state: &mut Value) {
     state["saved"] = match &files.last_save {
         Some((file, at)) => json!({"file": file, "at": at}),
+        None => Value::Null,
+    };
+    state["recovery"] = match files.recovery.found() {
+        Some(found) => json!({"file": found.path.display().to_string(), "at": found.at}),
         None => Value::Null,
     };
 }

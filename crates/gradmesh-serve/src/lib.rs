@@ -10,9 +10,12 @@
 //! requests whose `Host` or `Origin` is not this server are refused ([`security`]). It reads
 //! and writes documents only inside the starting folder, and saves atomically.
 
+pub mod clipboard;
 pub mod editor;
+pub mod exports;
 pub mod files;
 pub mod ops;
+pub mod recovery;
 pub mod refined;
 pub mod security;
 pub mod server;
@@ -36,6 +39,9 @@ use security::{Folder, Gate};
 pub struct Config {
     /// The document to open (any format gradmesh reads); `None` for a new document.
     pub file: Option<PathBuf>,
+    /// Documents whose layers go above those of `file`, in order. With any, the document has
+    /// no file to save to until "Save as".
+    pub layers_above: Vec<PathBuf>,
     /// The folder documents are opened from and saved to: the file's folder by default, else
     /// the current folder.
     pub folder: Option<PathBuf>,
@@ -75,7 +81,7 @@ pub fn open_app(config: &Config) -> Result<Arc<App>, String> {
     };
     let folder = Folder::new(&folder_path)
         .map_err(|e| format!("cannot use the folder {}: {e}", folder_path.display()))?;
-    let (editor, source) = match &config.file {
+    let (mut editor, mut source) = match &config.file {
         Some(file) => {
             let mut editor = Editor::open(file)?;
             // "save" writes inside the folder only.
@@ -88,9 +94,34 @@ pub fn open_app(config: &Config) -> Result<Arc<App>, String> {
         }
         None => (Editor::new_document(), None),
     };
+    if !config.layers_above.is_empty() {
+        let mut picture = editor.history.current().clone();
+        for file in &config.layers_above {
+            let layers =
+                files::read_layers(file).map_err(|e| format!("{}: {e}", file.display()))?;
+            picture.hidden.extend(layers.iter().map(|_| false));
+            picture.doc.layers.extend(layers);
+        }
+        editor = Editor {
+            history: History::new(picture),
+            path: None,
+        };
+        source = None;
+    }
+    // What a document without a file was made from: it names the recovery copy.
+    let mut key = folder.root().display().to_string();
+    for file in config.file.iter().chain(&config.layers_above) {
+        let file = file.canonicalize().unwrap_or_else(|_| file.clone());
+        key.push('\n');
+        key.push_str(&file.display().to_string());
+    }
     let app = App::new(editor, folder);
-    app.files()
-        .opened(source.as_deref(), &app.editor.lock().expect("a new lock"));
+    let editor = app.editor();
+    let warning = app.files().opened(source.as_deref(), &editor, &key);
+    drop(editor);
+    if let Some(warning) = warning {
+        eprintln!("gradmesh editor: {warning}");
+    }
     Ok(Arc::new(app))
 }
 
@@ -116,19 +147,82 @@ pub async fn start(config: &Config) -> Result<Running, String> {
     })
 }
 
-/// Serves `config` until the process ends, printing the URL to open.
+/// Serves `config` until the process is stopped, printing the URL to open. Recovery copies
+/// are kept ([`recovery`]); on Ctrl-C or SIGTERM the unsaved edits are written to the copy and
+/// its path printed.
 pub fn run(config: &Config) -> Result<(), String> {
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .enable_all()
         .build()
         .map_err(|e| format!("cannot start the server's runtime: {e}"))?;
-    runtime.block_on(async {
+    let result = runtime.block_on(async {
         let running = start(config).await?;
+        announce_recovery(&running.app);
         println!("gradmesh editor: open {}", running.url());
         println!("(listening on 127.0.0.1 only; stop with Ctrl-C)");
-        match running.task.await {
-            Ok(result) => result.map_err(|e| format!("the server stopped: {e}")),
-            Err(e) => Err(format!("the server stopped: {e}")),
+        tokio::select! {
+            ended = running.task => match ended {
+                Ok(result) => result.map_err(|e| format!("the server stopped: {e}")),
+                Err(e) => Err(format!("the server stopped: {e}")),
+            },
+            signal = stop_signal() => {
+                report_exit(&running.app, signal);
+                Ok(())
+            }
         }
-    })
+    });
+    runtime.shutdown_timeout(std::time::Duration::from_secs(2));
+    result
+}
+
+/// Turns recovery copies on and says if a copy of the document waits to be restored.
+fn announce_recovery(app: &App) {
+    let editor = app.editor();
+    let mut files = app.files();
+    if let Some(warning) = files.enable_recovery(recovery::default_state_dir(), &editor) {
+        eprintln!("gradmesh editor: {warning}");
+    }
+    if let Some(found) = files.recovery.found() {
+        println!(
+            "gradmesh editor: unsaved edits of this document were kept in {}; the page offers \
+             to restore or discard them",
+            found.path.display()
+        );
+    }
+}
+
+/// Waits for Ctrl-C or SIGTERM; returns which.
+async fn stop_signal() -> &'static str {
+    #[cfg(unix)]
+    {
+        use tokio::signal::unix::{signal, SignalKind};
+        if let Ok(mut terminate) = signal(SignalKind::terminate()) {
+            return tokio::select! {
+                _ = tokio::signal::ctrl_c() => "Ctrl-C",
+                _ = terminate.recv() => "SIGTERM",
+            };
+        }
+    }
+    let _ = tokio::signal::ctrl_c().await;
+    "Ctrl-C"
+}
+
+/// Keeps the unsaved edits in the recovery copy and says where they are.
+fn report_exit(app: &App, signal: &str) {
+    let editor = app.editor();
+    let mut files = app.files();
+    let kept = files.recovery.at_exit(&editor.history);
+    let end = match kept {
+        Ok(Some(path)) => format!(
+            " with unsaved edits; they are kept in {} (serve the same document again to restore \
+             them)",
+            path.display()
+        ),
+        Ok(None) if editor.history.modified() => "; the unsaved edits could not be kept (no \
+             state folder: set XDG_STATE_HOME or HOME)"
+            .into(),
+        Ok(None) => "; nothing was left unsaved".into(),
+        Err(e) => format!("; the unsaved edits could not be kept: {e}"),
+    };
+    println!("gradmesh editor: stopped by {signal}{end}");
 }

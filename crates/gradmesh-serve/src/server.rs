@@ -57,6 +57,7 @@ pub fn router(app: Arc<App>, gate: Gate) -> Router {
         .route("/api/document.json", get(document_json))
         .route("/api/picture.png", get(picture_png))
         .route("/api/refined", get(refined_vertices))
+        .route("/api/export", get(crate::exports::export_route))
         .route("/ws", get(websocket))
         .fallback(|| async { (StatusCode::NOT_FOUND, "no such page") })
         .layer(DefaultBodyLimit::max(MAX_BODY))

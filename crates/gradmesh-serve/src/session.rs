@@ -6,6 +6,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use gradmesh::render::View;
 use serde::Deserialize;
 
+use crate::clipboard;
 use crate::editor::Editor;
 use crate::files::{self, FileState, Refusal};
 use crate::ops::Op;
@@ -97,6 +98,46 @@ pub enum Command {
     },
     /// Starts a new document.
     New,
+    /// Restores (`restore: true`) or discards the recovery copy found at start.
+    Recovery {
+        /// Restore it; else discard it.
+        restore: bool,
+    },
+    /// Adds the layers of a document of the starting folder above the others.
+    ImportLayers {
+        /// Its name relative to the folder.
+        name: String,
+    },
+    /// Copies faces of a layer into a layer (the same or another), moved by `(dx, dy)`.
+    Paste {
+        /// The layer the faces are taken from.
+        from_layer: usize,
+        /// Its faces to copy.
+        faces: Vec<u32>,
+        /// The layer they are added to.
+        layer: usize,
+        /// Offset in x.
+        dx: f64,
+        /// Offset in y.
+        dy: f64,
+    },
+}
+
+impl Command {
+    /// Whether the command changes or saves the document (refused while a recovery copy
+    /// waits for the user's choice).
+    fn changes_document(&self) -> bool {
+        matches!(
+            self,
+            Command::Edit { .. }
+                | Command::Undo
+                | Command::Redo
+                | Command::Save { .. }
+                | Command::SaveAs { .. }
+                | Command::ImportLayers { .. }
+                | Command::Paste { .. }
+        )
+    }
 }
 
 /// A message for the page.
@@ -179,6 +220,9 @@ impl Session {
                 out.push(Outgoing::Select(message.to_string()));
             }
         }
+        if let Err(e) = self.keep_recovery() {
+            out.push(error_message(&format!("the recovery copy: {e}")));
+        }
         let doc = self.app.editor().history.current().visible();
         match self.viewer.render(&doc) {
             Ok(Some(frame)) => out.push(Outgoing::Binary(frame)),
@@ -219,10 +263,20 @@ impl Session {
         Some(state.to_string())
     }
 
+    /// Writes the recovery copy of the edits made so far (see [`crate::recovery`]).
+    fn keep_recovery(&self) -> Result<(), String> {
+        let editor = self.app.editor();
+        let mut files = self.app.files();
+        files.recovery.keep(&editor.history)
+    }
+
     /// Runs one command; returns the edit's note for the user, if any.
     fn run(&mut self, command: &Command) -> Result<Option<String>, Refusal> {
         let app = Arc::clone(&self.app);
         let mut editor = app.editor();
+        if command.changes_document() && app.files().recovery_pending() {
+            return Err(files::recovery_pending_refusal());
+        }
         let mut note = None;
         let done = match command {
             Command::Edit { op, gesture } => {
@@ -275,16 +329,33 @@ impl Session {
             Command::Open { name } => {
                 let path = app.folder.resolve(name)?;
                 *editor = Editor::open(&path)?;
-                app.files().opened(Some(&path), &editor);
+                let key = app.folder.root().join(name).display().to_string();
+                note = app.files().opened(Some(&path), &editor, &key);
                 self.told_version = None;
                 Ok(())
             }
             Command::New => {
                 *editor = Editor::new_document();
-                app.files().opened(None, &editor);
+                let key = app.folder.root().display().to_string();
+                note = app.files().opened(None, &editor, &key);
                 self.told_version = None;
                 Ok(())
             }
+            Command::Recovery { restore } => app.files().choose_recovery(&mut editor, *restore),
+            Command::ImportLayers { name } => files::import_layers(&app.folder, &mut editor, name),
+            Command::Paste {
+                from_layer,
+                faces,
+                layer,
+                dx,
+                dy,
+            } => clipboard::paste_faces(
+                &mut editor.history,
+                *from_layer,
+                faces,
+                *layer,
+                kurbo::Vec2::new(*dx, *dy),
+            ),
         };
         done.map(|()| note).map_err(Refusal::from)
     }

@@ -26,6 +26,7 @@ async fn serve_square() -> (Running, tempfile::TempDir) {
         file: Some(file),
         folder: None,
         port: 0,
+        ..Config::default()
     })
     .await
     .unwrap();
@@ -335,6 +336,7 @@ async fn a_new_document_is_drawn_and_saved_as() {
         file: None,
         folder: Some(dir.path().to_path_buf()),
         port: 0,
+        ..Config::default()
     })
     .await
     .unwrap();

@@ -26,6 +26,7 @@ async fn edit_in_a_real_browser() {
         file: Some(file.clone()),
         folder: None,
         port: 0,
+        ..Config::default()
     })
     .await
     .unwrap();
@@ -354,6 +355,7 @@ async fn the_tucan_in_a_real_browser() {
         file: Some(file),
         folder: None,
         port: 0,
+        ..Config::default()
     })
     .await
     .unwrap();

@@ -180,3 +180,100 @@ async fn a_json_opened_from_the_menu_saves_in_place_and_new_forgets_the_last_sav
         (&Value::Null, &Value::Null)
     );
 }
+
+async fn get(running: &Running, target: &str) -> (u16, Vec<u8>, String) {
+    let mut stream = TcpStream::connect(running.address).await.unwrap();
+    let head = format!(
+        "GET {target}&token={} HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nConnection: close\r\n\r\n",
+        running.token,
+        running.address.port(),
+    );
+    stream.write_all(head.as_bytes()).await.unwrap();
+    let mut answer = Vec::new();
+    stream.read_to_end(&mut answer).await.unwrap();
+    let split = answer.windows(4).position(|w| w == b"\r\n\r\n").unwrap();
+    let head = String::from_utf8_lossy(&answer[..split]).to_string();
+    let status = head.split(' ').nth(1).unwrap().parse().unwrap();
+    (status, answer[split + 4..].to_vec(), head)
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn exports_are_named_after_the_document_in_each_format() {
+    let dir = tempfile::tempdir().unwrap();
+    let square = dir.path().join("square.json");
+    std::fs::write(&square, SQUARE).unwrap();
+    let running = serve(Some(square), dir.path()).await;
+    for (format, magic, kind) in [
+        ("png", &b"\x89PNG"[..], "image/png"),
+        ("pdf", &b"%PDF-"[..], "application/pdf"),
+        ("svg", &b"<svg"[..], "image/svg+xml"),
+    ] {
+        let (status, body, head) =
+            get(&running, &format!("/api/export?format={format}&size=300")).await;
+        assert_eq!(status, 200, "{format}: {head}");
+        assert!(body.starts_with(magic), "{format}");
+        assert!(head.contains(kind), "{head}");
+        let name = format!("filename=\"square.{format}\"");
+        assert!(head.contains(&name), "{head}");
+    }
+    let (status, png, _) = get(&running, "/api/export?format=png&size=300").await;
+    assert_eq!(status, 200);
+    // A 300 x 300 image: the width and height of the PNG's header.
+    assert_eq!(&png[16..24], &[0, 0, 1, 44, 0, 0, 1, 44]);
+    for bad in ["format=gif", "format=png&size=0", "format=pdf&size=99999"] {
+        let (status, body, _) = get(&running, &format!("/api/export?{bad}")).await;
+        assert!((400..500).contains(&status), "{bad}: {status}");
+        assert!(!body.is_empty());
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn layers_come_from_several_files_and_imports_and_faces_are_pasted() {
+    let dir = tempfile::tempdir().unwrap();
+    let off = dir.path().join("beak.off");
+    std::fs::copy(shared_off("Tucan_Tucan_Layer0.off"), &off).unwrap();
+    let square = dir.path().join("square.json");
+    std::fs::write(&square, SQUARE).unwrap();
+    let running = start(&Config {
+        file: Some(square.clone()),
+        layers_above: vec![off],
+        ..Config::default()
+    })
+    .await
+    .unwrap();
+    let (_, state) = command(&running, r#"{"type":"state"}"#).await;
+    let names: Vec<&str> = (state["layers"].as_array().unwrap().iter())
+        .map(|l| l["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["square", "beak"]);
+    assert_eq!(state["file"], Value::Null, "several files: Save as");
+
+    let (status, state) =
+        command(&running, r#"{"type":"import_layers","name":"square.json"}"#).await;
+    assert_eq!(status, 200, "{state}");
+    assert_eq!(state["layers"].as_array().unwrap().len(), 3);
+    assert_eq!(state["can_undo"], true);
+    let (status, answer) = command(&running, r#"{"type":"import_layers","name":"../x.off"}"#).await;
+    assert_eq!(status, 422, "{answer}");
+
+    // Face 0 of the square pasted into the beak's layer, 200 units right.
+    let paste = r#"{"type":"paste","from_layer":0,"faces":[0],"layer":1,"dx":200,"dy":0}"#;
+    let (status, state) = command(&running, paste).await;
+    assert_eq!(status, 200, "{state}");
+    let beak = &state["layers"][1];
+    assert_eq!(beak["points"].as_array().unwrap().len(), 16);
+    assert_eq!(beak["points"][12], serde_json::json!([200.0, 0.0]));
+    assert_eq!(
+        beak["hex"][12], "#d04020",
+        "the colour follows, in the layer's space"
+    );
+    let (status, answer) = command(
+        &running,
+        r#"{"type":"paste","from_layer":0,"faces":[5],"layer":1,"dx":0,"dy":0}"#,
+    )
+    .await;
+    assert_eq!(status, 422, "{answer}");
+    command(&running, r#"{"type":"undo"}"#).await;
+    let (_, state) = command(&running, r#"{"type":"state"}"#).await;
+    assert_eq!(state["layers"][1]["points"].as_array().unwrap().len(), 12);
+}

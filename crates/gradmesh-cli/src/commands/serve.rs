@@ -7,7 +7,8 @@ use crate::args::ServeArgs;
 /// Serves the editor until the process is stopped.
 pub fn run(args: &ServeArgs) -> Result<(), Error> {
     let config = gradmesh_serve::Config {
-        file: args.file.clone(),
+        file: args.files.first().cloned(),
+        layers_above: args.files.iter().skip(1).cloned().collect(),
         folder: args.folder.clone(),
         port: args.port,
     };
