@@ -35,3 +35,4 @@ mod svg;
 mod svg_inkscape;
 mod threads;
 mod validation;
+mod vectorise;
