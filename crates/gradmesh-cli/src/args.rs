@@ -29,6 +29,8 @@ pub enum Command {
     Render(RenderArgs),
     /// List the multi-resolution edits of a mesh: the vertex each names, and what it changes.
     Edits(EditsArgs),
+    /// Fit a gradient mesh of free topology to a PNG or JPEG picture.
+    Vectorise(VectoriseArgs),
     /// Start the local web editor and print its URL (listens on 127.0.0.1 only).
     Serve(ServeArgs),
 }
@@ -306,6 +308,55 @@ pub struct RefineArgs {
     /// Limits.
     #[command(flatten)]
     pub limits: LimitArgs,
+}
+
+/// `gradmesh vectorise`.
+#[derive(Debug, Args)]
+pub struct VectoriseArgs {
+    /// The picture (.png or .jpg); its pixels are the output's coordinates.
+    pub input: PathBuf,
+    /// Output file (.json): one mesh covering the picture.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// The most control points (default 1024 when --psnr is not given either).
+    #[arg(long, value_name = "N")]
+    pub points: Option<usize>,
+    /// Stop once the fit reaches this PSNR in dB (or at --points, if given, first).
+    #[arg(long, value_name = "DB")]
+    pub psnr: Option<f64>,
+    /// The time spent on the fit.
+    #[arg(long, value_enum, default_value_t = QualityArg::Default)]
+    pub quality: QualityArg,
+    /// Allow the output to be the input file itself.
+    #[arg(long)]
+    pub force: bool,
+    /// Largest picture decoded, in pixels (checked in the file's header first).
+    #[arg(long, value_name = "N", help_heading = "Limits", default_value_t = gradmesh::MAX_IMAGE_PIXELS)]
+    pub max_pixels: u64,
+    /// Largest input file, in bytes.
+    #[arg(long, value_name = "BYTES", help_heading = "Limits", default_value_t = gradmesh::MAX_IMAGE_BYTES)]
+    pub max_input_bytes: u64,
+}
+
+/// `--quality` of `gradmesh vectorise`.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum QualityArg {
+    /// Coarse sampling, large rounds.
+    Fast,
+    /// The balance of time and accuracy.
+    Default,
+    /// Finer sampling, smaller rounds.
+    Best,
+}
+
+impl From<QualityArg> for gradmesh::Quality {
+    fn from(q: QualityArg) -> Self {
+        match q {
+            QualityArg::Fast => gradmesh::Quality::Fast,
+            QualityArg::Default => gradmesh::Quality::Default,
+            QualityArg::Best => gradmesh::Quality::Best,
+        }
+    }
 }
 
 /// `gradmesh render`.

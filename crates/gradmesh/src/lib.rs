@@ -40,6 +40,7 @@ mod edit_check;
 mod edits;
 mod error;
 pub mod export;
+mod fit;
 mod folds;
 pub mod formats;
 mod level;
@@ -59,6 +60,10 @@ mod validate;
 pub use colour::{parse_css_colour, ColourSpace};
 pub use edit_check::EditSet;
 pub use error::{Error, ErrorKind, Location, Result, Warning};
+pub use fit::{
+    fit_colours, psnr, vectorise, vectorise_with_progress, Progress, Quality, RgbaImage,
+    VectoriseOptions, Vectorised, MAX_IMAGE_BYTES, MAX_IMAGE_PIXELS,
+};
 pub use limit_matrix::{limit_matrix, LimitMatrix};
 pub use mesh::{ControlPoint, Document, EdgeKind, EdgeTag, GradientMesh, WedgeOverride};
 pub use multires::{ColourEdit, Edit, FineEdits, OpacityEdit, VertexAddress, MAX_EDIT_LEVEL};

@@ -7,6 +7,7 @@ mod refine;
 mod render;
 mod resvg_guard;
 mod serve;
+mod vectorise;
 mod whole_picture;
 
 use std::path::Path;
@@ -38,6 +39,7 @@ pub fn run(cli: Cli) -> Result<(), Failure> {
         Command::Render(a) => Ok(render::run(&a)?),
         Command::Edits(a) => Ok(edits::run(&a)?),
         Command::Serve(a) => Ok(serve::run(&a)?),
+        Command::Vectorise(a) => Ok(vectorise::run(&a)?),
     }
 }
 

@@ -36,3 +36,4 @@ mod svg;
 mod svg_inkscape;
 mod threads;
 mod validation;
+mod vectorise;

@@ -33,6 +33,17 @@ pub fn meshgradient(name: &str) -> PathBuf {
     )
 }
 
+/// The photograph `name` of `../shared/realdata/images` beside the repository, e.g.
+/// `"coffee.png"`.
+pub fn image(name: &str) -> PathBuf {
+    let crate_dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let path = crate_dir.join("../../../shared/realdata/images").join(name);
+    require(
+        path,
+        &format!("images/{name} is missing from ../shared/realdata"),
+    )
+}
+
 /// `path`; panics with `what` and the path when it does not exist.
 fn require(path: PathBuf, what: &str) -> PathBuf {
     assert!(

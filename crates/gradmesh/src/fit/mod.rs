@@ -1,0 +1,545 @@
+//! Fitting gradient meshes to pictures: the control colours of a mesh by least squares on its
+//! limit surface ([`fit_colours`]), and a whole picture turned into a mesh of free topology
+//! ([`vectorise`]).
+//!
+//! For a fixed topology and fixed edge tags the limit colour of every surface point is a fixed
+//! linear combination of the control colours ([`rows`]); the geometry only decides which
+//! surface point each pixel sees ([`raster`]). So the best colours for a given geometry solve a
+//! sparse linear least-squares problem in the working colour space ([`solve`]).
+//!
+//! [`vectorise`] starts from a coarse grid of cells over the picture, fits the colours, and
+//! splits the cells with the largest error into four ([`quadtree`]): a cell beside split ones
+//! becomes an n-gon, which the scheme handles as any other face. It repeats until the point
+//! budget or the PSNR asked for is reached. Point positions stay where the cells put them.
+
+mod image;
+mod quadtree;
+mod raster;
+mod rows;
+mod solve;
+
+use std::collections::{HashMap, HashSet};
+
+use crate::colour::{srgb_encode, ColourSpace};
+use crate::error::{Error, ErrorKind};
+use crate::limit_surface::limit_stencils;
+use crate::mesh::{Document, FirstStep, GradientMesh};
+use crate::refine::Refinement;
+use crate::render::{render_document_into, RenderOptions, View};
+use crate::size_limits::Limits;
+
+pub use image::{psnr, RgbaImage, MAX_IMAGE_BYTES, MAX_IMAGE_PIXELS};
+
+use image::{psnr_of_sum, Target};
+use quadtree::{Key, Quadtree};
+use raster::Observation;
+use solve::NormalEquations;
+
+/// How much time a fit may take.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Quality {
+    /// A coarse surface sampling and large refinement rounds.
+    Fast,
+    /// The balance of time and accuracy.
+    #[default]
+    Default,
+    /// A finer sampling, smaller rounds, tighter solves.
+    Best,
+}
+
+impl Quality {
+    /// Refined faces allowed per pixel when choosing the sampling level.
+    fn faces_per_pixel(self) -> f64 {
+        match self {
+            Quality::Fast => 0.25,
+            Quality::Default => 0.6,
+            Quality::Best => 1.5,
+        }
+    }
+
+    /// How much the point count may grow in one round of splits.
+    fn growth(self) -> f64 {
+        match self {
+            Quality::Fast => 1.7,
+            Quality::Default => 1.35,
+            Quality::Best => 1.15,
+        }
+    }
+
+    fn max_iterations(self) -> usize {
+        match self {
+            Quality::Fast => 60,
+            Quality::Default => 150,
+            Quality::Best => 400,
+        }
+    }
+}
+
+/// What [`vectorise`] aims at.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VectoriseOptions {
+    /// The most control points in all (at least 4). Without it or [`VectoriseOptions::psnr`],
+    /// 1024.
+    pub points: Option<usize>,
+    /// Stop once the fit reaches this PSNR (dB), or at [`VectoriseOptions::points`] (or
+    /// [`VectoriseOptions::max_points`]) if it comes first.
+    pub psnr: Option<f64>,
+    /// The time spent.
+    pub quality: Quality,
+    /// The working colour space of the mesh, in which the least squares are solved.
+    pub colour_space: ColourSpace,
+    /// The weight of the smoothness term (differences of colour along the mesh's edges),
+    /// relative to the average weight a control point gets from its pixels.
+    pub smoothness: f64,
+    /// The cap on the points when only a PSNR is asked for.
+    pub max_points: usize,
+    /// Cells are not split below this size, in pixels.
+    pub min_cell_px: f64,
+}
+
+impl Default for VectoriseOptions {
+    fn default() -> Self {
+        VectoriseOptions {
+            points: None,
+            psnr: None,
+            quality: Quality::Default,
+            colour_space: ColourSpace::Lab,
+            smoothness: 1e-3,
+            max_points: 1 << 15,
+            min_cell_px: 3.0,
+        }
+    }
+}
+
+/// What [`vectorise`] made.
+#[derive(Clone, Debug)]
+pub struct Vectorised {
+    /// One mesh covering the picture, in its pixel coordinates (`0..width` x `0..height`).
+    pub document: Document,
+    /// Its control points.
+    pub points: usize,
+    /// PSNR (dB) of the document rendered at the picture's size against the picture.
+    pub psnr: f64,
+    /// Rounds of fitting and splitting.
+    pub rounds: usize,
+}
+
+/// Where [`vectorise_with_progress`] has got to, after each round.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Progress {
+    /// Rounds done.
+    pub round: usize,
+    /// Control points of the mesh fitted.
+    pub points: usize,
+    /// PSNR (dB) of the fitted surface as the fit samples it.
+    pub psnr: f64,
+}
+
+fn invalid(what: &str, message: impl Into<String>) -> Error {
+    Error::new(ErrorKind::Invalid {
+        what: what.into(),
+        message: message.into(),
+    })
+}
+
+/// The colours of the points of a mesh fitted, and how the surface then sees the picture.
+struct Fitted {
+    colours: Vec<[f64; 3]>,
+    observation: Observation,
+    /// The limit colours of the sampled level's vertices.
+    vertex_colours: Vec<[f64; 3]>,
+}
+
+/// Settings of one colour fit.
+struct FitSettings {
+    faces_per_pixel: f64,
+    smoothness: f64,
+    tolerance: f64,
+    max_iterations: usize,
+}
+
+/// The sampling level: the deepest (2 to 6) whose faces number at most `faces_per_pixel` per
+/// pixel of the target, and at least level 2.
+fn sampling_level(mesh: &GradientMesh, pixels: usize, faces_per_pixel: f64) -> usize {
+    let corners = mesh.corner_count() as f64;
+    let allowed = pixels as f64 * faces_per_pixel;
+    let mut level = 2;
+    // Level k >= 2 has 9 * corners * 4^(k - 2) quads.
+    while level < 6 && 9.0 * corners * 4f64.powi(level as i32 - 1) <= allowed {
+        level += 1;
+    }
+    level
+}
+
+/// Refuses what the colour fit does not model: another first step, edits, wedge overrides.
+fn check_fittable(mesh: &GradientMesh) -> Result<(), Error> {
+    if mesh.first_step != FirstStep::Ternary {
+        return Err(invalid(
+            "mesh",
+            "the colour fit models the ternary first step only",
+        ));
+    }
+    if !mesh.edits.is_empty() || !mesh.wedges.is_empty() {
+        return Err(invalid(
+            "mesh",
+            "the colour fit does not model multi-resolution edits or wedge colours; remove them first",
+        ));
+    }
+    Ok(())
+}
+
+/// The mesh's edges as point pairs, once each.
+fn mesh_edges(mesh: &GradientMesh) -> Vec<[u32; 2]> {
+    let mut set = HashSet::new();
+    for f in &mesh.faces {
+        for (i, &a) in f.iter().enumerate() {
+            let b = f[(i + 1) % f.len()];
+            set.insert([a.min(b), a.max(b)]);
+        }
+    }
+    let mut edges: Vec<[u32; 2]> = set.into_iter().collect();
+    edges.sort_unstable();
+    edges
+}
+
+/// Fits the colours of `mesh` (positions fixed) to `target`, starting from `guess`.
+fn fit_mesh(
+    mesh: &GradientMesh,
+    target: &Target,
+    settings: &FitSettings,
+    mut colours: Vec<[f64; 3]>,
+) -> Result<Fitted, Error> {
+    let pixels = target.width * target.height;
+    let depth = sampling_level(mesh, pixels, settings.faces_per_pixel);
+    let (refinement, _) = Refinement::new_with_limits(mesh, depth, &Limits::DEFAULT)?;
+    let data = refinement.evaluate_to(refinement.base(), depth);
+    let limit = limit_stencils(refinement.level(depth)).expect("levels from 2 on are quads");
+    let positions: Vec<[f64; 2]> = limit
+        .apply(&data.levels[depth])
+        .iter()
+        .map(|d| [d[0], d[1]])
+        .collect();
+    drop(data);
+    let rows = rows::limit_colour_rows(&refinement, depth, &limit, mesh.points.len());
+    let observation = Observation::new(&refinement, depth, &positions, target);
+    let edges = mesh_edges(mesh);
+    let mut equations = NormalEquations {
+        rows: &rows,
+        observation: &observation,
+        edges: &edges,
+        lambda: 0.0,
+    };
+    let diagonal = equations.diagonal();
+    let mean = diagonal.iter().sum::<f64>() / diagonal.len().max(1) as f64;
+    equations.lambda = settings.smoothness * mean;
+    equations.solve(&mut colours, settings.tolerance, settings.max_iterations);
+    let vertex_colours = rows.apply(&colours);
+    Ok(Fitted {
+        colours,
+        observation,
+        vertex_colours,
+    })
+}
+
+/// Fits the control colours of `mesh` to `image` by least squares on its limit surface, in
+/// the mesh's colour space, with positions, handles and tags kept. The mesh's coordinates are
+/// the image's pixels. Pixels weigh by their alpha. Returns the PSNR (dB) of the fitted surface
+/// as the fit samples it (over the pixels it covers).
+pub fn fit_colours(
+    mesh: &mut GradientMesh,
+    image: &RgbaImage,
+    quality: Quality,
+) -> Result<f64, Error> {
+    check_fittable(mesh)?;
+    let target = Target::new(image, mesh.colour_space);
+    let settings = FitSettings {
+        faces_per_pixel: quality.faces_per_pixel(),
+        smoothness: 0.0,
+        tolerance: 1e-10,
+        max_iterations: 20 * quality.max_iterations(),
+    };
+    let guess = mesh.points.iter().map(|p| p.colour).collect();
+    let fitted = fit_mesh(mesh, &target, &settings, guess)?;
+    for (p, c) in mesh.points.iter_mut().zip(&fitted.colours) {
+        p.colour = *c;
+        p.colour_text = None;
+    }
+    let errors = pixel_errors(&fitted, &target, image, mesh.colour_space);
+    let (sum, count) = errors
+        .iter()
+        .flatten()
+        .fold((0.0, 0), |(s, n), &e| (s + e, n + 3));
+    Ok(psnr_of_sum(sum, count.max(1)))
+}
+
+/// Per pixel, the squared 8-bit sRGB error summed over the channels of what the fitted surface
+/// shows against the picture (`None` where the surface does not reach).
+fn pixel_errors(
+    fitted: &Fitted,
+    target: &Target,
+    image: &RgbaImage,
+    space: ColourSpace,
+) -> Vec<Option<f64>> {
+    use rayon::prelude::*;
+    let eight = |c: f64| (c.clamp(0.0, 1.0) * 255.0).round();
+    (0..target.width * target.height)
+        .into_par_iter()
+        .map(|i| {
+            let c = fitted.observation.predict(&fitted.vertex_colours, i)?;
+            let rgb = space.to_linear_srgb(c).map(srgb_encode);
+            let p = image.pixels[i];
+            Some(
+                (0..3)
+                    .map(|k| (eight(rgb[k]) - eight(p[k] as f64)).powi(2))
+                    .sum(),
+            )
+        })
+        .collect()
+}
+
+/// Turns a picture into a document of one gradient mesh in its pixel coordinates (see the
+/// module's documentation), within `options`' budget.
+pub fn vectorise(image: &RgbaImage, options: &VectoriseOptions) -> Result<Vectorised, Error> {
+    vectorise_with_progress(image, options, |_| {})
+}
+
+/// The starting grid: about `start` points, cells near square, none smaller than the
+/// smallest cell.
+fn initial_grid(width: f64, height: f64, start: usize, min_px: f64) -> (u32, u32) {
+    let start = (start as f64).max(4.0);
+    let aspect = width / height;
+    let fit = |n: f64, side: f64| (n.round() as u32).clamp(1, ((side / min_px) as u32).max(1));
+    let cols = fit((start * aspect).sqrt() - 1.0, width);
+    let rows = fit((start / aspect).sqrt() - 1.0, height);
+    (cols, rows)
+}
+
+/// [`vectorise`], calling `progress` after each round.
+pub fn vectorise_with_progress(
+    image: &RgbaImage,
+    options: &VectoriseOptions,
+    mut progress: impl FnMut(&Progress),
+) -> Result<Vectorised, Error> {
+    let budget = match (options.points, options.psnr) {
+        (Some(n), _) => n,
+        (None, Some(_)) => options.max_points,
+        (None, None) => 1024,
+    };
+    if budget < 4 {
+        return Err(invalid(
+            "points",
+            format!("{budget}: at least 4 are needed"),
+        ));
+    }
+    if let Some(db) = options.psnr {
+        if !(db.is_finite() && db > 0.0) {
+            return Err(invalid("psnr", format!("{db}: a positive number of dB")));
+        }
+    }
+    if image.width == 0 || image.height == 0 {
+        return Err(invalid("image", "the picture is empty"));
+    }
+    let (w, h) = (image.width as f64, image.height as f64);
+    let space = options.colour_space;
+    let target = Target::new(image, space);
+    let quality = options.quality;
+    let settings = FitSettings {
+        faces_per_pixel: quality.faces_per_pixel(),
+        smoothness: options.smoothness,
+        tolerance: 1e-4,
+        max_iterations: quality.max_iterations(),
+    };
+    let min_px = options.min_cell_px.max(0.5);
+    // A quarter of a point budget; few points when only a PSNR is asked for.
+    let start = match options.points {
+        Some(n) => n / 4,
+        None => 16,
+    };
+    let (cols, rows) = initial_grid(w, h, start, min_px);
+    let mut tree = Quadtree::new(w, h, cols, rows);
+    let mut known: HashMap<Key, [f64; 3]> = HashMap::new();
+    let mut round = 0;
+    loop {
+        let shape = tree.mesh();
+        let mut mesh = GradientMesh::new(space);
+        mesh.name = Some("vectorised".into());
+        for (k, p) in shape.keys.iter().zip(&shape.positions) {
+            let colour = known
+                .get(k)
+                .copied()
+                .unwrap_or_else(|| target_colour_at(&target, *p));
+            mesh.add_point(*p, colour);
+        }
+        for f in shape.faces {
+            mesh.add_face(f);
+        }
+        let guess = mesh.points.iter().map(|p| p.colour).collect();
+        let fitted = fit_mesh(&mesh, &target, &settings, guess)?;
+        for (p, c) in mesh.points.iter_mut().zip(&fitted.colours) {
+            p.colour = *c;
+        }
+        known = shape
+            .keys
+            .iter()
+            .copied()
+            .zip(fitted.colours.iter().copied())
+            .collect();
+        let errors = pixel_errors(&fitted, &target, image, space);
+        let total: f64 = errors.iter().map(|e| e.unwrap_or(0.0)).sum();
+        let model_psnr = psnr_of_sum(total, 3 * errors.len());
+        round += 1;
+        progress(&Progress {
+            round,
+            points: mesh.points.len(),
+            psnr: model_psnr,
+        });
+        let reached = options.psnr.is_some_and(|db| model_psnr >= db);
+        let chosen = if reached {
+            Vec::new()
+        } else {
+            choose_splits(&tree, &fitted, &errors, budget, quality.growth(), min_px)
+        };
+        if chosen.is_empty() {
+            return finish(mesh, image, round);
+        }
+        tree.split(&chosen);
+    }
+}
+
+/// The picture's colour at the pixel under `p`.
+fn target_colour_at(target: &Target, p: kurbo::Point) -> [f64; 3] {
+    let x = (p.x.floor().max(0.0) as usize).min(target.width - 1);
+    let y = (p.y.floor().max(0.0) as usize).min(target.height - 1);
+    target.colour[y * target.width + x]
+}
+
+/// The leaves to split next: largest error first, adding at most `(growth - 1)` times the
+/// points there are and never going past `budget`.
+fn choose_splits(
+    tree: &Quadtree,
+    fitted: &Fitted,
+    errors: &[Option<f64>],
+    budget: usize,
+    growth: f64,
+    min_px: f64,
+) -> Vec<usize> {
+    let mut leaf_error = vec![0.0; tree.leaves.len()];
+    for (i, e) in errors.iter().enumerate() {
+        let f = fitted.observation.base_face[i];
+        if let (Some(e), true) = (e, f != raster::UNCOVERED) {
+            leaf_error[f as usize] += e;
+        }
+    }
+    let mut order: Vec<usize> = (0..tree.leaves.len())
+        .filter(|&i| tree.can_split(&tree.leaves[i], min_px) && leaf_error[i] > 0.0)
+        .collect();
+    order.sort_by(|&a, &b| leaf_error[b].total_cmp(&leaf_error[a]));
+    let mut present = tree.corner_keys();
+    let points = present.len();
+    let room = budget.saturating_sub(points);
+    let allowance = room.min(((growth - 1.0) * points as f64).ceil().max(5.0) as usize);
+    let mut added = 0;
+    let mut chosen = Vec::new();
+    for i in order {
+        let new = Quadtree::new_points(&tree.leaves[i], &present);
+        if added + new.len() > allowance {
+            continue;
+        }
+        added += new.len();
+        present.extend(new);
+        chosen.push(i);
+        if added == allowance {
+            break;
+        }
+    }
+    chosen
+}
+
+/// The document of `mesh`, rendered at the picture's size to measure its PSNR.
+fn finish(mesh: GradientMesh, image: &RgbaImage, rounds: usize) -> Result<Vectorised, Error> {
+    let points = mesh.points.len();
+    let document = Document { layers: vec![mesh] };
+    let view = View::new(0.0, 0.0, image.width as f64, image.height as f64);
+    let opts = RenderOptions::new(image.width, image.height, view);
+    let mut out = vec![0u8; 4 * image.width as usize * image.height as usize];
+    render_document_into(&document, &opts, &mut out)?;
+    let rendered = RgbaImage::from_rgba8(image.width, image.height, &out)?;
+    Ok(Vectorised {
+        psnr: psnr(image, &rendered)?,
+        document,
+        points,
+        rounds,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A quadtree mesh over a 60 x 40 picture with one cell split (so one face is a pentagon
+    /// and one point has valence three), coloured by `colour(i)`.
+    fn tree_mesh(colour: impl Fn(usize) -> [f64; 3]) -> GradientMesh {
+        let mut tree = Quadtree::new(60.0, 40.0, 3, 2);
+        tree.split(&[1]);
+        let shape = tree.mesh();
+        let mut mesh = GradientMesh::new(ColourSpace::Lab);
+        for (i, p) in shape.positions.iter().enumerate() {
+            mesh.add_point(*p, colour(i));
+        }
+        for f in shape.faces {
+            mesh.add_face(f);
+        }
+        mesh
+    }
+
+    /// With the same topology and geometry, the least-squares step recovers the control colours
+    /// of a picture made by the fit's own sampling of the limit surface to 1e-6.
+    #[test]
+    fn least_squares_recovers_known_colours() {
+        let known = |i: usize| {
+            let t = i as f64;
+            [
+                30.0 + 5.0 * (t * 0.7).sin() + t,
+                20.0 * (t * 1.3).cos(),
+                3.0 * t - 20.0,
+            ]
+        };
+        let mesh = tree_mesh(known);
+        assert!(mesh.faces.iter().any(|f| f.len() == 5));
+        let blank = Target {
+            width: 60,
+            height: 40,
+            colour: vec![[0.0; 3]; 2400],
+            weight: vec![1.0; 2400],
+        };
+        let settings = FitSettings {
+            faces_per_pixel: 0.6,
+            smoothness: 0.0,
+            tolerance: 1e-13,
+            max_iterations: 5000,
+        };
+        let truth: Vec<[f64; 3]> = mesh.points.iter().map(|p| p.colour).collect();
+        // The picture: what the fit's sampling shows of the true colours (no solver step).
+        let sample_only = FitSettings {
+            max_iterations: 0,
+            ..settings
+        };
+        let seen = fit_mesh(&mesh, &blank, &sample_only, truth.clone()).unwrap();
+        let mut target = blank.clone();
+        for i in 0..2400 {
+            let c = seen.observation.predict(&seen.vertex_colours, i);
+            target.colour[i] = c.expect("the mesh covers the picture");
+        }
+        let guess = vec![[50.0, 0.0, 0.0]; truth.len()];
+        let settings = FitSettings {
+            max_iterations: 5000,
+            ..sample_only
+        };
+        let fitted = fit_mesh(&mesh, &target, &settings, guess).unwrap();
+        for (got, want) in fitted.colours.iter().zip(&truth) {
+            for k in 0..3 {
+                assert!((got[k] - want[k]).abs() < 1e-6, "{got:?} vs {want:?}");
+            }
+        }
+    }
+}

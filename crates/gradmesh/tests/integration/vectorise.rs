@@ -1,0 +1,247 @@
+//! `vectorise` and `fit_colours`: pictures into meshes, known meshes back from their renders,
+//! and hostile files.
+
+use gradmesh::render::{render_document, RenderOptions, View};
+use gradmesh::{
+    fit_colours, psnr, vectorise, ColourSpace, Document, ErrorKind, GradientMesh, Quality,
+    RgbaImage, VectoriseOptions,
+};
+use kurbo::Point;
+
+/// The f32 render of `doc` over `0..w` x `0..h`, one pixel per unit.
+fn render(doc: &Document, w: u32, h: u32) -> RgbaImage {
+    let opts = RenderOptions::new(w, h, View::new(0.0, 0.0, w as f64, h as f64));
+    let image = render_document(doc, &opts).unwrap();
+    RgbaImage {
+        width: w,
+        height: h,
+        pixels: image
+            .data
+            .chunks_exact(4)
+            .map(|p| [p[0], p[1], p[2], p[3]])
+            .collect(),
+    }
+}
+
+/// A 4 x 3 grid of quads over `0..120` x `0..90` with smoothly varying Lab colours, all
+/// inside the sRGB gamut (the renderer maps others, which no fit in Lab can then match).
+fn grid_mesh() -> GradientMesh {
+    let mut m = GradientMesh::new(ColourSpace::Lab);
+    for j in 0..4 {
+        for i in 0..5 {
+            let (x, y) = (i as f64, j as f64);
+            m.add_point(
+                Point::new(30.0 * x, 30.0 * y),
+                [40.0 + 6.0 * x + 3.0 * y, 6.0 * (x - 2.0), 14.0 - 8.0 * y],
+            );
+        }
+    }
+    for j in 0..3 {
+        for i in 0..4 {
+            let a = 5 * j + i;
+            m.add_face(vec![a, a + 1, a + 6, a + 5]);
+        }
+    }
+    m
+}
+
+/// A flat picture is one colour everywhere: the fit renders it back above 40 dB.
+#[test]
+fn a_flat_picture_fits_above_40_db() {
+    let image = RgbaImage::filled(97, 61, [0.8, 0.35, 0.1, 1.0]);
+    let options = VectoriseOptions {
+        points: Some(64),
+        ..VectoriseOptions::default()
+    };
+    let v = vectorise(&image, &options).unwrap();
+    assert!(v.points <= 64 && v.points >= 4, "{} points", v.points);
+    assert!(v.psnr > 40.0, "{} dB", v.psnr);
+}
+
+/// The colours of a mesh fitted to its own render (the renderer's f32 output, same topology
+/// and geometry) come back within a small fraction of a Lab unit: the fit's sampling of the
+/// surface agrees with the renderer's.
+#[test]
+fn fit_colours_recovers_a_rendered_mesh() {
+    let truth = grid_mesh();
+    let image = render(
+        &Document {
+            layers: vec![truth.clone()],
+        },
+        120,
+        90,
+    );
+    let mut mesh = truth.clone();
+    for p in &mut mesh.points {
+        p.colour = [50.0, 0.0, 0.0];
+    }
+    let model_psnr = fit_colours(&mut mesh, &image, Quality::Best).unwrap();
+    assert!(model_psnr > 45.0, "{model_psnr} dB");
+    let worst = mesh
+        .points
+        .iter()
+        .zip(&truth.points)
+        .flat_map(|(a, b)| (0..3).map(move |k| (a.colour[k] - b.colour[k]).abs()))
+        .fold(0.0, f64::max);
+    assert!(worst < 0.5, "largest colour difference {worst}");
+}
+
+/// Round trip: a known mesh rendered to a picture, vectorised with at most twice its points,
+/// renders back close to the picture.
+#[test]
+fn a_rendered_mesh_vectorises_back() {
+    let mesh = grid_mesh();
+    let image = render(&Document { layers: vec![mesh] }, 120, 90);
+    let options = VectoriseOptions {
+        points: Some(40),
+        ..VectoriseOptions::default()
+    };
+    let v = vectorise(&image, &options).unwrap();
+    assert!(v.points <= 40);
+    assert!(v.psnr > 36.0, "{} dB with {} points", v.psnr, v.points);
+    // The document covers the picture: its render at the picture's size has no hole.
+    let back = render(&v.document, 120, 90);
+    assert!(back.pixels.iter().all(|p| p[3] > 0.99));
+    assert!((psnr(&image, &back).unwrap() - v.psnr).abs() < 1.0);
+}
+
+/// Noise has no structure: the fit still ends within its budget, with no panic.
+#[test]
+fn noise_stays_within_the_budget() {
+    let mut state = 12345u32;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        (state % 256) as f32 / 255.0
+    };
+    let pixels = (0..80 * 50)
+        .map(|_| [next(), next(), next(), 1.0])
+        .collect();
+    let image = RgbaImage {
+        width: 80,
+        height: 50,
+        pixels,
+    };
+    for quality in [Quality::Fast, Quality::Default] {
+        let options = VectoriseOptions {
+            points: Some(150),
+            quality,
+            ..VectoriseOptions::default()
+        };
+        let v = vectorise(&image, &options).unwrap();
+        assert!(v.points <= 150 && v.points > 4);
+        assert!(v.psnr.is_finite());
+    }
+}
+
+/// The PSNR goal stops the refinement: a smooth picture needs few points for 30 dB.
+#[test]
+fn a_psnr_goal_stops_early() {
+    let image = render(
+        &Document {
+            layers: vec![grid_mesh()],
+        },
+        120,
+        90,
+    );
+    let options = VectoriseOptions {
+        psnr: Some(30.0),
+        ..VectoriseOptions::default()
+    };
+    let v = vectorise(&image, &options).unwrap();
+    assert!(v.psnr > 29.0, "{} dB", v.psnr);
+    assert!(v.points < 200, "{} points", v.points);
+}
+
+/// A PNG chunk: length, type and data, CRC.
+fn chunk(kind: &[u8; 4], data: &[u8]) -> Vec<u8> {
+    let mut body = kind.to_vec();
+    body.extend(data);
+    let mut crc = flate2::Crc::new();
+    crc.update(&body);
+    let mut bytes = (data.len() as u32).to_be_bytes().to_vec();
+    bytes.extend(body);
+    bytes.extend(crc.sum().to_be_bytes());
+    bytes
+}
+
+/// A PNG file that claims `width` x `height` RGB pixels and holds a few bytes of data.
+fn png_header(width: u32, height: u32) -> Vec<u8> {
+    let mut ihdr = width.to_be_bytes().to_vec();
+    ihdr.extend(height.to_be_bytes());
+    ihdr.extend([8, 2, 0, 0, 0]);
+    let mut bytes = b"\x89PNG\r\n\x1a\n".to_vec();
+    bytes.extend(chunk(b"IHDR", &ihdr));
+    bytes.extend(chunk(b"IDAT", &[0x78, 0x9c, 0x03, 0x00]));
+    bytes.extend(chunk(b"IEND", &[]));
+    bytes
+}
+
+/// A small real PNG.
+fn small_png() -> Vec<u8> {
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, 8, 8);
+    encoder.set_color(png::ColorType::Rgba);
+    let mut writer = encoder.write_header().unwrap();
+    writer.write_image_data(&[128; 8 * 8 * 4]).unwrap();
+    writer.finish().unwrap();
+    bytes
+}
+
+/// Files that are not pictures, cut short, empty or huge give clear errors, never a panic,
+/// and a huge size is refused from the header before anything is decoded.
+#[test]
+fn hostile_files_give_clear_errors() {
+    let limit = gradmesh::MAX_IMAGE_PIXELS;
+    let message = |bytes: &[u8]| RgbaImage::decode(bytes, limit).unwrap_err().to_string();
+    assert!(message(b"").contains("not a PNG or JPEG"));
+    assert!(message(b"{\"layers\": []}").contains("not a PNG or JPEG"));
+    let huge = RgbaImage::decode(&png_header(50_000, 50_000), limit).unwrap_err();
+    assert!(
+        matches!(huge.kind, ErrorKind::LimitExceeded { found, .. } if found == 2_500_000_000),
+        "{huge}"
+    );
+    assert!(message(&png_header(0, 0)).contains("PNG image"));
+    let png = small_png();
+    assert_eq!(RgbaImage::decode(&png, limit).unwrap().width, 8);
+    for cut in [9, 20, 33, png.len() - 13] {
+        assert!(message(&png[..cut]).contains("PNG image"), "cut at {cut}");
+    }
+    let jpeg = std::fs::read(crate::realdata::image("rocket.jpg")).unwrap();
+    let decoded = RgbaImage::decode(&jpeg, limit).unwrap();
+    assert_eq!((decoded.width, decoded.height), (640, 427));
+    for cut in [3, 100, 600] {
+        assert!(message(&jpeg[..cut]).contains("JPEG image"), "cut at {cut}");
+    }
+    // A picture above a small limit is refused.
+    let small = RgbaImage::decode(&jpeg, 1000).unwrap_err();
+    assert!(
+        matches!(small.kind, ErrorKind::LimitExceeded { .. }),
+        "{small}"
+    );
+}
+
+/// Options that cannot be met are refused with the option's name.
+#[test]
+fn bad_options_are_refused() {
+    let image = RgbaImage::filled(10, 10, [0.5, 0.5, 0.5, 1.0]);
+    let few = VectoriseOptions {
+        points: Some(3),
+        ..VectoriseOptions::default()
+    };
+    assert!(vectorise(&image, &few)
+        .unwrap_err()
+        .to_string()
+        .contains("points"));
+    let nan = VectoriseOptions {
+        psnr: Some(f64::NAN),
+        ..VectoriseOptions::default()
+    };
+    assert!(vectorise(&image, &nan)
+        .unwrap_err()
+        .to_string()
+        .contains("psnr"));
+    let empty = RgbaImage::filled(0, 10, [0.0; 4]);
+    assert!(vectorise(&empty, &VectoriseOptions::default()).is_err());
+}
