@@ -421,9 +421,9 @@ pub struct RenderArgs {
     /// the surface's.
     #[arg(long, value_name = "DELTA_E", default_value_t = gradmesh::export::DEFAULT_TOLERANCE, help_heading = "Vector output")]
     pub tolerance: f64,
-    /// PDF and SVG: largest distance, in points, between the flat patches at the surface's irregular
+    /// PDF and SVG: largest distance, in pixels, between the flat patches at the surface's irregular
     /// spots and the surface.
-    #[arg(long, value_name = "PT", default_value_t = gradmesh::export::DEFAULT_GEOMETRY_TOLERANCE_PX, help_heading = "Vector output")]
+    #[arg(long, value_name = "PX", default_value_t = gradmesh::export::DEFAULT_GEOMETRY_TOLERANCE_PX, help_heading = "Vector output")]
     pub geometry_tolerance: f64,
     /// PDF: the shadings' colour space (sRGB, drawn alike by every viewer; or Lab, for viewers
     /// that interpolate in Lab and convert it exactly).

@@ -48,10 +48,10 @@ fn a_pdf_is_written_with_the_png_page_size() {
     let o = gradmesh(&["render", s(&input), "-o", s(&png), "--width", "160"]);
     assert!(o.status.success(), "{}", stderr(&o));
 
-    // A 72-dpi rasterisation has the PNG's size.
+    // A 96-dpi rasterisation has the PNG's size.
     let drawn = dir.path().join("drawn.png");
     let o = Command::new("mutool")
-        .args(["draw", "-q", "-r", "72", "-o", s(&drawn), s(&pdf), "1"])
+        .args(["draw", "-q", "-r", "96", "-o", s(&drawn), s(&pdf), "1"])
         .output()
         .unwrap_or_else(|e| panic!("mutool could not be run ({e}): apt-get install mupdf-tools"));
     assert!(o.status.success(), "{}", stderr(&o));

@@ -172,7 +172,7 @@ fn every_test_file_round_trips_through_json_and_renders_both_ways() {
         // The JSON keeps the root's user units: drawn with the SVG's view box.
         let text = std::fs::read_to_string(&svg).unwrap();
         let scene = gradmesh::formats::svg::read_svg(&text).unwrap();
-        let view = scene.view_rect().unwrap();
+        let view = scene.view_rect();
         let numbers = [w, h]
             .map(|v| v.to_string())
             .into_iter()

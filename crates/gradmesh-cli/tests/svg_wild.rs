@@ -177,3 +177,138 @@ fn a_whole_picture_over_the_memory_limit_is_refused() {
     );
     assert!(out.status.success(), "{}", stderr(&out));
 }
+
+/// The bounding box (x0, y0, x1, y1) of the pixels where `is` holds.
+fn bounds(png: &Path, is: impl Fn(&[u8]) -> bool) -> Option<(u32, u32, u32, u32)> {
+    let (w, _, data) = decode_png(png);
+    let mut b: Option<(u32, u32, u32, u32)> = None;
+    for (i, p) in data.chunks_exact(4).enumerate() {
+        if is(p) {
+            let (x, y) = (i as u32 % w, i as u32 / w);
+            b = Some(match b {
+                None => (x, y, x, y),
+                Some((x0, y0, x1, y1)) => (x0.min(x), y0.min(y), x1.max(x), y1.max(y)),
+            });
+        }
+    }
+    b
+}
+
+/// A 200 x 100 viewport over a 200 x 200 view box (`xMidYMid meet`, the initial value): the
+/// view box is drawn at half size in the middle, so the red square stays square.
+#[test]
+fn preserve_aspect_ratio_keeps_squares_square() {
+    let (out, dir) = render("F7-preserveAspectRatio-ignored.svg", &[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let png = dir.path().join("out.png");
+    let (w, h, _) = decode_png(&png);
+    assert_eq!((w, h), (200, 100));
+    let red = |p: &[u8]| p[0] > 200 && p[1] < 60 && p[2] < 60 && p[3] > 200;
+    // The square of side 110 (stroke 4) at (45, 45): x 71.5-128.5, y 21.5-78.5 in pixels.
+    let (x0, y0, x1, y1) = bounds(&png, red).expect("the red square is drawn");
+    assert!((x1 - x0).abs_diff(y1 - y0) <= 1, "{:?}", (x0, y0, x1, y1));
+    assert!(
+        (71..=73).contains(&x0) && (21..=23).contains(&y0),
+        "{:?}",
+        (x0, y0)
+    );
+    // Left of the view box (x < 50 px) nothing is drawn.
+    assert_eq!(bounds(&png, |p| p[3] > 0).map(|b| b.0), Some(50));
+}
+
+/// A relative `<image href>` is found beside the SVG file wherever the command runs; when it
+/// is missing, a warning names it.
+#[test]
+fn relative_images_are_found_beside_the_file() {
+    let (out, dir) = render("F9-external-image-dropped.svg", &[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("image"), "{}", stderr(&out));
+    let png = dir.path().join("out.png");
+    // The image covers x 110-190, y 10-90.
+    let drawn = bounds(&png, |p| p[3] > 127).expect("something is drawn");
+    assert!(drawn.2 >= 185, "{drawn:?}");
+
+    let alone = tempfile::tempdir().unwrap();
+    let svg = alone.path().join("F9.svg");
+    std::fs::copy(wild("F9-external-image-dropped.svg"), &svg).unwrap();
+    let out = gradmesh_in(
+        dir.path(),
+        &["render", svg.to_str().unwrap(), "-o", "alone.png"],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let message = stderr(&out);
+    assert!(
+        message.contains("<image> at 3:3: href \"image.png\"") && message.contains("missing"),
+        "{message}"
+    );
+}
+
+/// `width="0" height="0"` and no view box: CSS's default size, 300 x 150, showing the green
+/// rect beneath the mesh.
+#[test]
+fn a_zero_size_is_the_css_default() {
+    let (out, dir) = render("F10-zero-size-view-is-mesh-bounds.svg", &[]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let png = dir.path().join("out.png");
+    let (w, h, data) = decode_png(&png);
+    assert_eq!((w, h), (300, 150));
+    let pixel = |x: u32, y: u32| &data[4 * (y * w + x) as usize..][..4];
+    assert_eq!(pixel(150, 120)[3], 255);
+    assert!(
+        pixel(150, 120)[1] > 100 && pixel(150, 120)[0] < 30,
+        "{:?}",
+        pixel(150, 120)
+    );
+    assert_eq!(pixel(250, 50)[3], 0);
+}
+
+/// An invalid attribute on another element is ignored with a warning naming the element, the
+/// attribute and the line; the rest of the picture is drawn.
+#[test]
+fn invalid_attributes_are_ignored_with_a_warning() {
+    for (name, attribute) in [
+        ("F11-invalid-opacity-rejects-file.svg", "opacity \"1x\""),
+        (
+            "F11b-invalid-transform-rejects-file.svg",
+            "transform \"qwe\"",
+        ),
+    ] {
+        let (out, dir) = render(name, &[]);
+        let message = stderr(&out);
+        assert!(out.status.success(), "{name}: {message}");
+        assert!(
+            message.contains(&format!("<rect> at 3:3: {attribute}")) && message.contains("ignored"),
+            "{name}: {message}"
+        );
+        // The black square at x 110-190 is drawn, as resvg draws it.
+        let (w, _, data) = decode_png(&dir.path().join("out.png"));
+        let p = &data[4 * (50 * w + 150) as usize..][..4];
+        assert_eq!(p, [0, 0, 0, 255], "{name}");
+    }
+}
+
+/// PDF pages are in points at 96 CSS pixels to 72 points, as Inkscape makes them: the
+/// 129.47 mm x 244.54 mm drawing is a 367 x 693.17 pt page (Inkscape 1.2.2's MediaBox).
+#[test]
+fn pdf_pages_have_inkscapes_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let svg = wild("F8-pdf-page-size-inkscape-ext-mesh.svg");
+    let out = gradmesh_in(
+        dir.path(),
+        &["render", svg.to_str().unwrap(), "-o", "out.pdf"],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let pdf = std::fs::read(dir.path().join("out.pdf")).unwrap();
+    let text = String::from_utf8_lossy(&pdf);
+    let at = text.find("/MediaBox [").expect("a MediaBox");
+    let numbers: Vec<f64> = text[at + 11..]
+        .split(']')
+        .next()
+        .unwrap()
+        .split_whitespace()
+        .map(|n| n.parse().unwrap())
+        .collect();
+    assert_eq!(numbers.len(), 4, "{numbers:?}");
+    assert!((numbers[2] - 367.0).abs() < 0.01, "{numbers:?}");
+    assert!((numbers[3] - 693.174).abs() < 0.01, "{numbers:?}");
+}

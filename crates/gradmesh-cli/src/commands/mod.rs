@@ -98,10 +98,10 @@ fn read_with_viewport(path: &Path, limits: &gradmesh::Limits, page: usize) -> Re
     }
     if Format::from_path(path) == Some(Format::Svg) {
         let read = svg::read_path_with_limits(path, limits)?;
-        let viewport = read
-            .view
-            .map(gradmesh::render::View::from_rect)
-            .zip(read.pixel_size);
+        let viewport = Some((
+            gradmesh::render::View::from_rect(read.view),
+            read.pixel_size,
+        ));
         return Ok(Input {
             document: read.document,
             viewport,

@@ -150,7 +150,12 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
     }
     if kind != Output::Png {
         let pdf = kind == Output::Pdf;
-        return vector(args, &doc, &opts, pdf, &origins, read).map_err(locate);
+        // The page has the file's own size, not rounded to whole pixels, unless the flags
+        // give a size or a view.
+        let sized_by_flags = args.width.is_some() || args.height.is_some() || args.view.is_some();
+        let page_px = viewport.filter(|_| !sized_by_flags).map(|(_, size)| size);
+        let output = VectorOutput { pdf, page_px };
+        return vector(args, &doc, &opts, output, &origins, read).map_err(locate);
     }
     // The image's size and view are checked before its buffer is allocated.
     opts.check()?;
@@ -166,8 +171,9 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
             let text = std::fs::read_to_string(path)
                 .map_err(|e| Error::new(ErrorKind::Io(format!("{}: {e}", path.display()))))?;
             let max_memory = args.max_memory.unwrap_or_else(machine_memory);
-            let drawn = whole_picture::render_whole_picture(&text, layers, &opts, max_memory)
-                .map_err(|e| locate(e).in_file(path))?;
+            let drawn =
+                whole_picture::render_whole_picture((path, &text), layers, &opts, max_memory)
+                    .map_err(|e| locate(e).in_file(path))?;
             print_left_out(path, &left_out[0].1, drawn.is_ok());
             if let Err(message) = &drawn {
                 eprintln!(
@@ -314,17 +320,25 @@ fn draw<P: render::OutputPixel>(
     }
 }
 
-/// Writes the document as a PDF (`pdf`) or an SVG, with the page and view of `render`.
+/// What vector output is written: a PDF (`pdf`) or an SVG, with the page's size in CSS
+/// pixels when it is not the render's.
+struct VectorOutput {
+    pdf: bool,
+    page_px: Option<(f64, f64)>,
+}
+
+/// Writes the document as a PDF or an SVG, with the page and view of `render`.
 fn vector(
     args: &RenderArgs,
     doc: &Document,
     render: &RenderOptions,
-    pdf: bool,
+    VectorOutput { pdf, page_px }: VectorOutput,
     origins: &[(&std::path::Path, usize)],
     read: std::time::Duration,
 ) -> Result<(), Error> {
     warn_of_png_flags(args);
     let mut opts = ExportOptions::new(render.width, render.height, render.view);
+    opts.page_px = page_px;
     opts.tolerance = args.tolerance;
     opts.geometry_tolerance_px = args.geometry_tolerance;
     opts.colour = args.pdf_colour.into();
@@ -344,17 +358,20 @@ fn vector(
     if args.timings {
         let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
         eprintln!("read       {:9.2} ms", ms(read));
+        let (page_w, page_h) = opts.page_size_px();
+        let scale = if pdf { export::POINTS_PER_PIXEL } else { 1.0 };
         eprintln!(
-            "export     {:9.2} ms ({}x{} pt, {} patches, {} bytes)",
+            "export     {:9.2} ms ({:.2}x{:.2} {}, {} patches, {} bytes)",
             ms(made),
-            opts.width,
-            opts.height,
+            page_w * scale,
+            page_h * scale,
+            if pdf { "pt" } else { "px" },
             info.patches,
             bytes.len()
         );
         eprintln!("write      {:9.2} ms", ms(start.elapsed()));
         eprintln!(
-            "flat patches at irregular spots: {}, largest distance {:.4} pt",
+            "flat patches at irregular spots: {}, largest distance {:.4} px",
             info.approximated, info.geometry_error_px
         );
     }

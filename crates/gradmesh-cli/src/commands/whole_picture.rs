@@ -19,6 +19,7 @@
 
 use std::collections::HashSet;
 use std::ops::Range;
+use std::path::Path;
 
 use gradmesh::render::{self, Image, PictureLayer, RenderOptions};
 use gradmesh::{Error, ErrorKind};
@@ -364,11 +365,14 @@ fn render_segment(
     Ok(Ok(pixmap))
 }
 
-/// resvg's options: the system's fonts, and for each generic family (and text that names no
+/// resvg's options: relative links resolved against `folder` (the file's), the system's fonts, and for each generic family (and text that names no
 /// font) the first of some common metric-compatible families that the system has, as the
 /// defaults (Times New Roman, Arial, Courier New) are often missing on Linux.
-fn resvg_options() -> resvg::usvg::Options<'static> {
-    let mut options = resvg::usvg::Options::default();
+fn resvg_options(folder: &Path) -> resvg::usvg::Options<'static> {
+    let mut options = resvg::usvg::Options {
+        resources_dir: Some(folder.to_path_buf()),
+        ..Default::default()
+    };
     let db = options.fontdb_mut();
     db.load_system_fonts();
     let installed: HashSet<String> = db
@@ -407,6 +411,40 @@ fn resvg_options() -> resvg::usvg::Options<'static> {
     options
 }
 
+/// Warnings for the `<image>` elements of `doc` whose file is missing: relative links are
+/// resolved against `folder`; other URLs are never fetched.
+fn missing_images(doc: &Document, folder: &Path) -> Vec<String> {
+    let mut warnings = Vec::new();
+    for node in doc
+        .descendants()
+        .filter(|n| is_svg(*n) && n.tag_name().name() == "image")
+    {
+        let href = node
+            .attribute(("http://www.w3.org/1999/xlink", "href"))
+            .or_else(|| node.attribute("href"));
+        let Some(href) = href.map(str::trim) else {
+            continue;
+        };
+        if href.starts_with("data:") {
+            continue;
+        }
+        let pos = doc.text_pos_at(node.range().start);
+        let place = format!("<image> at {}:{}", pos.row, pos.col);
+        let local = href.strip_prefix("file://").unwrap_or(href);
+        if local.contains("://") {
+            warnings.push(format!(
+                "{place}: href {href:?} is not a local file and is never fetched: not drawn"
+            ));
+        } else if !folder.join(local).is_file() {
+            warnings.push(format!(
+                "{place}: href {href:?} names {}, which is missing: not drawn",
+                folder.join(local).display()
+            ));
+        }
+    }
+    warnings
+}
+
 /// `over` (premultiplied RGBA8) composited over `acc` (premultiplied `f32`).
 fn composite_pixmap(acc: &mut [f32], over: &resvg::tiny_skia::Pixmap) {
     for (a, p) in acc.chunks_exact_mut(4).zip(over.data().chunks_exact(4)) {
@@ -428,14 +466,15 @@ fn composite_image(acc: &mut [f32], over: &[f32]) {
     }
 }
 
-/// The whole picture of SVG `text`: `mesh_layers` (its mesh fills, bottom first, as gradmesh
+/// The whole picture of SVG `text` (read from `path`: its relative links are resolved against
+/// its folder, and missing images are warned of): `mesh_layers` (its mesh fills, bottom first, as gradmesh
 /// read them) between the rest of its content drawn by resvg, on `opts.background`. Straight
 /// alpha, like every [`Image`]. `Ok(Err(message))` when the file's content cannot be split
 /// around its mesh fills or resvg cannot read it (the caller then draws the meshes alone).
 /// An error when resvg panics, or when the picture's memory (estimated) is over `max_memory`
 /// or a buffer resvg would allocate is over `opts.max_pixels`.
 pub fn render_whole_picture(
-    text: &str,
+    (path, text): (&Path, &str),
     mesh_layers: &[PictureLayer<'_>],
     opts: &RenderOptions,
     max_memory: u64,
@@ -464,7 +503,11 @@ pub fn render_whole_picture(
     let pixels = u64::from(opts.width) * u64::from(opts.height);
     let base = pixels.saturating_mul(BYTES_PER_PIXEL);
     check_memory(base, max_memory, opts)?;
-    let options = resvg_options();
+    let folder = path.parent().unwrap_or(Path::new("."));
+    for warning in missing_images(&doc, folder) {
+        eprintln!("gradmesh: warning: {}: {warning}", path.display());
+    }
+    let options = resvg_options(folder);
     let mut acc = background_canvas(opts);
     let mut layer_opts = opts.clone();
     layer_opts.background = None;

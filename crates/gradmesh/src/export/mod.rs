@@ -49,7 +49,7 @@ use crate::size_limits::Limits;
 use split::{OutPatch, Splitter, Target};
 use surface::{layer_surface, Curve, SurfaceOptions};
 
-pub use pdf::write_pdf;
+pub use pdf::{write_pdf, POINTS_PER_PIXEL};
 pub use svg::write_svg;
 
 /// The default colour tolerance, in ΔE00 ([`ExportOptions::tolerance`]).
@@ -87,10 +87,14 @@ impl PdfColour {
 /// How to export a document.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ExportOptions {
-    /// Page width in points (one pixel of the same render is one point).
+    /// Picture width in CSS pixels: the page is `width` x `height` pixels of a render of the
+    /// same options, at 96 pixels to the inch (a PDF page is 0.75 point a pixel).
     pub width: u32,
-    /// Page height in points.
+    /// Picture height in CSS pixels.
     pub height: u32,
+    /// The page's exact size in CSS pixels when it is not `width` x `height` (an SVG file's
+    /// own size, say 489.33 x 924.23 for 129.47 mm x 244.54 mm): the picture is scaled to it.
+    pub page_px: Option<(f64, f64)>,
     /// The rectangle of the plane mapped onto the page.
     pub view: View,
     /// Largest colour difference (ΔE00) between the viewer's bilinear colour and the surface's,
@@ -112,6 +116,7 @@ impl ExportOptions {
         ExportOptions {
             width,
             height,
+            page_px: None,
             view,
             tolerance: DEFAULT_TOLERANCE,
             geometry_tolerance_px: DEFAULT_GEOMETRY_TOLERANCE_PX,
@@ -120,10 +125,25 @@ impl ExportOptions {
         }
     }
 
+    /// The page's size in CSS pixels: [`ExportOptions::page_px`], or else `width` x `height`.
+    pub fn page_size_px(&self) -> (f64, f64) {
+        self.page_px
+            .unwrap_or((f64::from(self.width), f64::from(self.height)))
+    }
+
     /// Refuses a page or view that [`RenderOptions::check`] refuses for an image of the same
-    /// size, and tolerances that are not positive and finite.
+    /// size, a page size that is not positive and finite, and tolerances that are not
+    /// positive and finite.
     pub fn check(&self) -> Result<(), Error> {
         RenderOptions::new(self.width, self.height, self.view).check()?;
+        let (pw, ph) = self.page_size_px();
+        if !(pw.is_finite() && ph.is_finite() && pw > 0.0 && ph > 0.0) {
+            return Err(ErrorKind::Invalid {
+                what: "the page size".into(),
+                message: format!("must be positive, not {pw} x {ph}"),
+            }
+            .into());
+        }
         for (name, value) in [
             ("export tolerance", self.tolerance),
             ("export geometry tolerance", self.geometry_tolerance_px),

@@ -44,8 +44,12 @@ const STREAM_ORDER: [(usize, usize); 16] = [
 /// (`(0, 0)`, `(1, 0)`, `(1, 1)`, `(0, 1)` in `(u, v)`).
 const CORNER_ORDER: [usize; 4] = [0, 3, 2, 1];
 
-/// The document as a one-page PDF of `opts.width` x `opts.height` points (a 72 dpi
-/// rasterisation has the size of a render of the same options), and what was written.
+/// Points in a CSS pixel: 72 to the inch against 96.
+pub const POINTS_PER_PIXEL: f64 = 0.75;
+
+/// The document as a one-page PDF of the page size ([`ExportOptions::page_size_px`]) at 72
+/// points to 96 CSS pixels (a 96 dpi rasterisation has the size of a render of the same
+/// options), and what was written.
 pub fn write_pdf(doc: &Document, opts: &ExportOptions) -> Result<(Vec<u8>, ExportInfo), Error> {
     let target = match opts.colour {
         PdfColour::Lab => Target::Lab,
@@ -80,12 +84,19 @@ fn pdf_bytes(
     pdf.catalog(catalog).pages(tree);
     pdf.pages(tree).kids([page_id]).count(1);
     let (w, h) = (opts.width as f32, opts.height as f32);
-    let page_rect = Rect::new(0.0, 0.0, w, h);
+    // The picture's pixels, and the page in points.
+    let pixel_rect = Rect::new(0.0, 0.0, w, h);
+    let (page_w, page_h) = opts.page_size_px();
+    let (page_w, page_h) = (
+        (page_w * POINTS_PER_PIXEL) as f32,
+        (page_h * POINTS_PER_PIXEL) as f32,
+    );
+    let page_rect = Rect::new(0.0, 0.0, page_w, page_h);
 
     let mut content = Content::new();
     content.save_state();
     // Pixel coordinates: y down from the top edge.
-    content.transform([1.0, 0.0, 0.0, -1.0, 0.0, h]);
+    content.transform([page_w / w, 0.0, 0.0, -page_h / h, 0.0, page_h]);
     let mut shadings = Vec::new();
     let mut states = Vec::new();
     for (k, layer) in layers.iter().enumerate() {
@@ -110,7 +121,7 @@ fn pdf_bytes(
             mask.shading(Name(alpha_name.as_bytes()));
             let mask = mask.finish();
             let mut group = pdf.form_xobject(form, &mask);
-            group.bbox(page_rect);
+            group.bbox(pixel_rect);
             group
                 .resources()
                 .shadings()

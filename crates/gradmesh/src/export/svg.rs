@@ -16,7 +16,8 @@ use crate::error::Error;
 use crate::mesh::Document;
 use crate::render::{encode_png, render_image, PngDepth, RenderOptions};
 
-/// The document as an SVG of `opts.width` x `opts.height` pixels, with a PNG of the render
+/// The document as an SVG of the page size ([`ExportOptions::page_size_px`]) in CSS pixels,
+/// drawn on a grid of `opts.width` x `opts.height`, with a PNG of the render
 /// beneath the meshes when `fallback` is set (browsers show it; Inkscape draws the meshes
 /// over it), and what was written.
 pub fn write_svg(
@@ -27,10 +28,11 @@ pub fn write_svg(
     let (layers, mut info) = layer_patches(doc, opts, Target::Srgb)?;
     let start = std::time::Instant::now();
     let (w, h) = (opts.width, opts.height);
+    let (page_w, page_h) = opts.page_size_px();
     let mut out = String::new();
     let _ = writeln!(
         out,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" width="{w}" height="{h}" viewBox="0 0 {w} {h}">"#
+        r#"<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" width="{page_w}" height="{page_h}" viewBox="0 0 {w} {h}">"#
     );
     if fallback {
         let (image, _) = render_image(doc, &RenderOptions::new(w, h, opts.view))?;

@@ -1,5 +1,5 @@
 //! PDF export checked by independent renderers: MuPDF (`mutool draw`), poppler (`pdftoppm`)
-//! and Ghostscript rasterise the PDF at 72 dpi (one point a pixel), and the result is compared
+//! and Ghostscript rasterise the PDF at 96 dpi (a CSS pixel a pixel), and the result is compared
 //! with gradmesh's own render of the same document on white: CIEDE2000 over the layers'
 //! interior (the covered pixels, eroded by a few pixels), and the outline's position (the
 //! area between the two coverages, per pixel of outline). A missing renderer fails the test,
@@ -98,7 +98,7 @@ impl Tool {
         }
     }
 
-    /// Rasterises `pdf` at 72 dpi (an SVG for Inkscape at 96, its pixel) into a PNG beside it
+    /// Rasterises `pdf` (or an SVG, for Inkscape) at 96 dpi, a CSS pixel a pixel, into a PNG beside it
     /// (with alpha where the tool gives it).
     pub(crate) fn rasterise(self, pdf: &Path) -> Raster {
         let (program, package) = self.program();
@@ -106,12 +106,12 @@ impl Tool {
         let mut cmd = Command::new(program);
         match self {
             Tool::Mutool => cmd
-                .args(["draw", "-q", "-r", "72", "-c", "rgba", "-o"])
+                .args(["draw", "-q", "-r", "96", "-c", "rgba", "-o"])
                 .arg(&out)
                 .arg(pdf)
                 .arg("1"),
             Tool::Pdftoppm => cmd
-                .args(["-r", "72", "-png", "-singlefile"])
+                .args(["-r", "96", "-png", "-singlefile"])
                 .arg(pdf)
                 .arg(out.with_extension("")),
             Tool::Ghostscript => cmd
@@ -121,7 +121,7 @@ impl Tool {
                     "-dBATCH",
                     "-dNOPAUSE",
                     "-sDEVICE=pngalpha",
-                    "-r72",
+                    "-r96",
                     "-dGraphicsAlphaBits=4",
                 ])
                 .arg(format!("-sOutputFile={}", out.display()))

@@ -271,7 +271,7 @@ fn all_thirteen_files_are_read_as_their_text_says() {
         let scene = read(expected);
         let name = expected.file;
         let [x0, y0, x1, y1] = expected.view;
-        assert_eq!(scene.view_rect(), Some(Rect::new(x0, y0, x1, y1)), "{name}");
+        assert_eq!(scene.view_rect(), Rect::new(x0, y0, x1, y1), "{name}");
         assert_eq!(scene.fills.len(), expected.fills.len(), "{name}");
         for (fill, want) in scene.fills.iter().zip(expected.fills) {
             let grid = &fill.mesh;

@@ -166,9 +166,9 @@ fn compare(file: &str, name: &str) -> [Difference; 2] {
     let scene = svg::read_svg(&text).unwrap_or_else(|e| panic!("{file}: {e}"));
     let reference = inkscape_render(name);
     let (w, h) = (reference.width, reference.height);
-    let (pw, ph) = scene.pixel_size().expect("the test files give their size");
+    let (pw, ph) = scene.pixel_size();
     assert_eq!((pw.round() as u32, ph.round() as u32), (w, h), "{file}");
-    let view = View::from_rect(scene.view_rect().expect("a view box"));
+    let view = View::from_rect(scene.view_rect());
     let mut opts = RenderOptions::new(w, h, view);
     opts.dither = false;
     let render = |mode| {

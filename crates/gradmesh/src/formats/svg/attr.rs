@@ -52,6 +52,16 @@ pub(super) fn warning_at(node: Node, message: impl std::fmt::Display) -> String 
     format!("{} at {line}:{column}: {message}", describe(node))
 }
 
+/// A warning that an invalid attribute of `node` is ignored, from the error reading it gave
+/// (which names the element, the attribute and the value).
+pub(super) fn ignored(node: Node, e: &Error) -> String {
+    let text = e.kind.to_string();
+    let (_, column) = line_column(node);
+    let prefix = format!("{} at column {column}: ", describe(node));
+    let message = text.strip_prefix(&prefix).unwrap_or(&text);
+    warning_at(node, format!("{message}: ignored"))
+}
+
 /// Whether `node` is an SVG element (or an element in no namespace) named one of `names`.
 pub(super) fn is_svg_element(node: Node, names: &[&str]) -> bool {
     let tag = node.tag_name();

@@ -38,7 +38,9 @@ use std::path::Path;
 
 pub use convert::{fill_to_layer, scene_to_document};
 pub use read::{read_svg_with_limits, MAX_DEPTH};
-pub use scene::{Corner, FillRule, MeshFill, MeshGrid, MeshType, SvgScene};
+pub use scene::{
+    AspectRatio, Corner, FillRule, MeshFill, MeshGrid, MeshType, SvgScene, DEFAULT_SIZE,
+};
 
 use crate::colour::ColourSpace;
 use crate::error::{Error, ErrorKind, Warning};
@@ -58,9 +60,9 @@ pub struct SvgDocument {
     /// What was left out, naming the element.
     pub warnings: Vec<Warning>,
     /// The rectangle of user space the picture shows ([`SvgScene::view_rect`]).
-    pub view: Option<kurbo::Rect>,
+    pub view: kurbo::Rect,
     /// The picture's size in CSS pixels ([`SvgScene::pixel_size`]).
-    pub pixel_size: Option<(f64, f64)>,
+    pub pixel_size: (f64, f64),
     /// The fills the layers were converted from, `fills[i]` for layer `i`: their clips, and
     /// what the classic rendering draws.
     pub fills: Vec<MeshFill>,

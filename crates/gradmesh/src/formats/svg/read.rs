@@ -8,7 +8,7 @@ use roxmltree::{Document, Node, ParsingOptions};
 
 use super::attr::{self, error_at, is_svg_element, warning_at};
 use super::gradient::{self, Units};
-use super::scene::{FillRule, MeshFill, MeshGrid, SvgScene};
+use super::scene::{AspectRatio, FillRule, MeshFill, MeshGrid, SvgScene};
 use super::shape;
 use crate::error::{Error, ErrorKind, Location};
 use crate::formats::check_size;
@@ -61,17 +61,14 @@ pub fn read_svg_with_limits(text: &str, limits: &Limits) -> Result<SvgScene, Err
         return Err(error_at(root, "the root element is not <svg>"));
     }
     let mut reader = Reader::new(&doc, limits);
-    let view = reader.viewport(root)?;
-    let transform = attr::transform_attribute(root, "transform")?;
-    let opacity = attr::own_opacity(root, "opacity")?;
+    let mut scene = reader.viewport(root);
+    let transform = attr::transform_attribute(root, "transform");
+    let transform = reader.or_ignored(root, transform, Affine::IDENTITY);
+    let opacity = reader.or_ignored(root, attr::own_opacity(root, "opacity"), 1.0);
     reader.walk(root, transform, opacity, 1)?;
-    Ok(SvgScene {
-        view_box: view.0,
-        width: view.1,
-        height: view.2,
-        fills: reader.fills,
-        warnings: reader.warnings,
-    })
+    scene.fills = reader.fills;
+    scene.warnings = reader.warnings;
+    Ok(scene)
 }
 
 /// Entities are refused: they are rare in SVG and can blow up (entity expansion).
@@ -120,9 +117,9 @@ impl<'a, 'input> Reader<'a, 'input> {
         }
     }
 
-    /// The root's `viewBox`, `width` and `height`; sets the base of percentages.
-    #[allow(clippy::type_complexity)]
-    fn viewport(&mut self, root: Node) -> Result<(Option<Rect>, Option<f64>, Option<f64>), Error> {
+    /// The root's `viewBox`, `preserveAspectRatio`, `width` and `height` (invalid values
+    /// ignored with a warning), in a scene with no fills yet; sets the base of percentages.
+    fn viewport(&mut self, root: Node) -> SvgScene {
         let view_box = match root.attribute("viewBox") {
             Some(text) => match svgtypes::ViewBox::from_str(text) {
                 Ok(v)
@@ -142,22 +139,50 @@ impl<'a, 'input> Reader<'a, 'input> {
             },
             None => None,
         };
-        let absolute = |name: &str| -> Result<Option<f64>, Error> {
-            match root.attribute(name) {
-                Some(t) if !t.trim_end().ends_with('%') => {
-                    Ok(Some(attr::length(root, name, t, 0.0)?).filter(|v| *v > 0.0))
+        let aspect = match root.attribute("preserveAspectRatio") {
+            Some(text) => match svgtypes::AspectRatio::from_str(text) {
+                Ok(a) => aspect_ratio(a),
+                Err(e) => {
+                    self.warnings.push(warning_at(
+                        root,
+                        format!("preserveAspectRatio {text:?} is not valid ({e}): ignored"),
+                    ));
+                    AspectRatio::default()
                 }
-                _ => Ok(None),
-            }
+            },
+            None => AspectRatio::default(),
         };
-        let (width, height) = (absolute("width")?, absolute("height")?);
-        self.percent_base = view_box.unwrap_or(Rect::new(
-            0.0,
-            0.0,
-            width.unwrap_or(100.0),
-            height.unwrap_or(100.0),
-        ));
-        Ok((view_box, width, height))
+        let mut absolute = |name: &str| match root.attribute(name) {
+            Some(t) if !t.trim_end().ends_with('%') => {
+                let length = attr::length(root, name, t, 0.0).map(Some);
+                self.or_ignored(root, length, None).filter(|v| *v > 0.0)
+            }
+            _ => None,
+        };
+        let (width, height) = (absolute("width"), absolute("height"));
+        let scene = SvgScene {
+            view_box,
+            aspect,
+            width,
+            height,
+            fills: Vec::new(),
+            warnings: Vec::new(),
+        };
+        let (w, h) = scene.pixel_size();
+        self.percent_base = view_box.unwrap_or(Rect::new(0.0, 0.0, w, h));
+        scene
+    }
+
+    /// The value read, or else `default` with a warning that the invalid attribute of `node`
+    /// is ignored (as browsers and resvg ignore it).
+    fn or_ignored<T>(&mut self, node: Node, read: Result<T, Error>, default: T) -> T {
+        match read {
+            Ok(value) => value,
+            Err(e) => {
+                self.warnings.push(attr::ignored(node, &e));
+                default
+            }
+        }
     }
 
     /// Walks the children of `node` in paint order; `ctm` maps their user space to the root's.
@@ -183,8 +208,10 @@ impl<'a, 'input> Reader<'a, 'input> {
             {
                 continue;
             }
-            let child_ctm = ctm * attr::transform_attribute(child, "transform")?;
-            let child_opacity = opacity * attr::own_opacity(child, "opacity")?;
+            let transform = attr::transform_attribute(child, "transform");
+            let child_ctm = ctm * self.or_ignored(child, transform, Affine::IDENTITY);
+            let own_opacity = attr::own_opacity(child, "opacity");
+            let child_opacity = opacity * self.or_ignored(child, own_opacity, 1.0);
             match child.tag_name().name() {
                 "g" | "a" | "switch" => self.walk(child, child_ctm, child_opacity, depth + 1)?,
                 name if shape::SHAPES.contains(&name) => {
@@ -232,11 +259,26 @@ impl<'a, 'input> Reader<'a, 'input> {
             self.warn_paint(node, "fill");
             return Ok(());
         };
-        let Some(outline) = shape::outline(node, self.percent_base)? else {
+        let outline = shape::outline(node, self.percent_base);
+        let Some(outline) = self.or_ignored(node, outline, None) else {
             return Ok(());
         };
-        let Some(mesh) = self.mesh_for(gradient, node, outline.bounding_box())? else {
-            return Ok(());
+        let mesh = match self.mesh_for(gradient, node, outline.bounding_box()) {
+            Ok(Some(mesh)) => mesh,
+            Ok(None) => return Ok(()),
+            Err(e) if matches!(e.kind, ErrorKind::LimitExceeded { .. }) => return Err(e),
+            Err(e) => {
+                let line = e
+                    .location
+                    .line
+                    .map(|l| format!("line {l}: "))
+                    .unwrap_or_default();
+                self.warnings.push(warning_at(
+                    node,
+                    format!("its mesh-gradient fill is left out: {line}{}", e.kind),
+                ));
+                return Ok(());
+            }
         };
         let mut clip = outline;
         clip.apply_affine(ctm);
@@ -252,7 +294,7 @@ impl<'a, 'input> Reader<'a, 'input> {
             _ => FillRule::NonZero,
         };
         let fill_opacity = match attr::inherited_property(node, "fill-opacity") {
-            Some(text) => attr::opacity(node, "fill-opacity", text)?,
+            Some(text) => self.or_ignored(node, attr::opacity(node, "fill-opacity", text), 1.0),
             None => 1.0,
         };
         self.fills.push(MeshFill {
@@ -313,6 +355,27 @@ impl<'a, 'input> Reader<'a, 'input> {
             ));
         }
         Ok(Some(transformed(mesh, units_map * gradient.transform)))
+    }
+}
+
+/// svgtypes' `preserveAspectRatio` as the scene records it (`defer` applies to images only).
+fn aspect_ratio(a: svgtypes::AspectRatio) -> AspectRatio {
+    use svgtypes::Align as A;
+    let align = match a.align {
+        A::None => None,
+        A::XMinYMin => Some((0.0, 0.0)),
+        A::XMidYMin => Some((0.5, 0.0)),
+        A::XMaxYMin => Some((1.0, 0.0)),
+        A::XMinYMid => Some((0.0, 0.5)),
+        A::XMidYMid => Some((0.5, 0.5)),
+        A::XMaxYMid => Some((1.0, 0.5)),
+        A::XMinYMax => Some((0.0, 1.0)),
+        A::XMidYMax => Some((0.5, 1.0)),
+        A::XMaxYMax => Some((1.0, 1.0)),
+    };
+    AspectRatio {
+        align,
+        slice: a.slice,
     }
 }
 

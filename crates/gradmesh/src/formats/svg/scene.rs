@@ -18,9 +18,11 @@ use kurbo::{BezPath, CubicBez, Point, Rect};
 pub struct SvgScene {
     /// The root's `viewBox`, when it has a valid one.
     pub view_box: Option<Rect>,
-    /// The root's `width`, in CSS pixels, when given as an absolute length.
+    /// The root's `preserveAspectRatio`.
+    pub aspect: AspectRatio,
+    /// The root's `width`, in CSS pixels, when given as a positive absolute length.
     pub width: Option<f64>,
-    /// The root's `height`, in CSS pixels, when given as an absolute length.
+    /// The root's `height`, in CSS pixels, when given as a positive absolute length.
     pub height: Option<f64>,
     /// The shapes filled with a mesh gradient, bottom first.
     pub fills: Vec<MeshFill>,
@@ -29,24 +31,78 @@ pub struct SvgScene {
     pub warnings: Vec<String>,
 }
 
+/// CSS's size of a replaced element that gives none, in pixels.
+pub const DEFAULT_SIZE: (f64, f64) = (300.0, 150.0);
+
 impl SvgScene {
-    /// The rectangle of user space the picture shows: the `viewBox`, or else `(0, 0)` to the
-    /// root's width and height. `None` when the file gives neither.
-    pub fn view_rect(&self) -> Option<Rect> {
-        self.view_box.or(match (self.width, self.height) {
-            (Some(w), Some(h)) => Some(Rect::new(0.0, 0.0, w, h)),
-            _ => None,
-        })
+    /// The picture's size in CSS pixels: the root's `width` and `height`; a side missing (or
+    /// zero) follows from the other and the view box's aspect ratio, or is the view box's
+    /// when both are missing (as Inkscape and resvg size such files); without a view box,
+    /// CSS's default of 300 x 150.
+    pub fn pixel_size(&self) -> (f64, f64) {
+        match (self.width, self.height, self.view_box) {
+            (Some(w), Some(h), _) => (w, h),
+            (Some(w), None, Some(b)) => (w, w * b.height() / b.width()),
+            (None, Some(h), Some(b)) => (h * b.width() / b.height(), h),
+            (None, None, Some(b)) => (b.width(), b.height()),
+            (w, h, None) => (w.unwrap_or(DEFAULT_SIZE.0), h.unwrap_or(DEFAULT_SIZE.1)),
+        }
     }
 
-    /// The picture's size in CSS pixels: the root's `width` and `height`, or else the view
-    /// box's size. `None` when the file gives neither.
-    pub fn pixel_size(&self) -> Option<(f64, f64)> {
-        match (self.width, self.height, self.view_box) {
-            (Some(w), Some(h), _) => Some((w, h)),
-            (_, _, Some(b)) => Some((b.width(), b.height())),
-            _ => None,
+    /// The rectangle of user space the picture shows: the view box fitted into the picture
+    /// ([`SvgScene::pixel_size`]) as `preserveAspectRatio` says (with `meet` it grows to fill
+    /// the picture, with `slice` it is cut to it), or else `(0, 0)` to the picture's size.
+    pub fn view_rect(&self) -> Rect {
+        let (w, h) = self.pixel_size();
+        match self.view_box {
+            Some(b) => self.aspect.fit(b, w, h),
+            None => Rect::new(0.0, 0.0, w, h),
         }
+    }
+}
+
+/// How the view box is fitted into the viewport (`preserveAspectRatio`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AspectRatio {
+    /// Where the view box goes along x and along y within the viewport: 0 at the start
+    /// (`xMin`, `yMin`), 0.5 in the middle, 1 at the end; `None` for `none` (stretched).
+    pub align: Option<(f64, f64)>,
+    /// `slice` (the view box covers the viewport and is cut) rather than `meet` (the view box
+    /// lies wholly inside the viewport).
+    pub slice: bool,
+}
+
+impl Default for AspectRatio {
+    /// `xMidYMid meet`, the initial value.
+    fn default() -> Self {
+        AspectRatio {
+            align: Some((0.5, 0.5)),
+            slice: false,
+        }
+    }
+}
+
+impl AspectRatio {
+    /// The rectangle of user space that a `width` x `height` viewport shows of view box
+    /// `view_box`: the view box scaled uniformly and placed as `align` says. Aspect ratios
+    /// within a millionth of each other are taken as equal (editors write sizes such as
+    /// 600.00005 x 399.99998 for 600 x 400): the view box itself.
+    pub fn fit(&self, view_box: Rect, width: f64, height: f64) -> Rect {
+        let Some((ax, ay)) = self.align else {
+            return view_box;
+        };
+        let (sx, sy) = (width / view_box.width(), height / view_box.height());
+        if (sx - sy).abs() <= 1e-6 * sx.max(sy) {
+            return view_box;
+        }
+        let scale = if self.slice { sx.max(sy) } else { sx.min(sy) };
+        if !(scale.is_finite() && scale > 0.0) {
+            return view_box;
+        }
+        let (w, h) = (width / scale, height / scale);
+        let x0 = view_box.x0 - (w - view_box.width()) * ax;
+        let y0 = view_box.y0 - (h - view_box.height()) * ay;
+        Rect::new(x0, y0, x0 + w, y0 + h)
     }
 }
 

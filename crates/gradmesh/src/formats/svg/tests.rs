@@ -31,6 +31,13 @@ fn error(body: &str) -> String {
     read_svg(&svg(body)).unwrap_err().to_string()
 }
 
+/// The warnings of a document whose only shape's mesh-gradient fill is left out.
+fn left_out(body: &str) -> String {
+    let scene = read(body);
+    assert!(scene.fills.is_empty(), "{body}");
+    scene.warnings.join("\n")
+}
+
 fn close(a: Point, b: Point) -> bool {
     a.distance(b) < 1e-9
 }
@@ -282,32 +289,35 @@ fn other_content_is_named_in_warnings() {
 }
 
 #[test]
-fn errors_name_the_element_and_its_place() {
+fn mesh_errors_leave_the_fill_out_naming_the_element_and_its_place() {
     let gradient = |stops: &str| {
         format!(
             r##"<meshgradient id="m" gradientUnits="userSpaceOnUse"><meshrow><meshpatch id="p">{stops}</meshpatch></meshrow></meshgradient>
 <rect width="5" height="5" fill="url(#m)"/>"##
         )
     };
-    let e = error(&gradient(r#"<stop path="l 1,0"/><stop path="l 0,1"/>"#));
-    assert!(e.starts_with(r#"1: <meshpatch id="p"> at column "#), "{e}");
+    let e = left_out(&gradient(r#"<stop path="l 1,0"/><stop path="l 0,1"/>"#));
+    assert!(
+        e.starts_with(r#"<rect> at 2:1: its mesh-gradient fill is left out: line 1: <meshpatch id="p"> at column "#),
+        "{e}"
+    );
     assert!(
         e.ends_with("has 2 stops; it needs 4 (one per side not shared with an earlier patch)"),
         "{e}"
     );
-    let e = error(&gradient(r#"<stop id="s" path="l 1,0 l 0,1"/>"#));
+    let e = left_out(&gradient(r#"<stop id="s" path="l 1,0 l 0,1"/>"#));
     assert!(
         e.contains(r#"<stop id="s"> at column"#) && e.contains("is not one l, L, c or C command"),
         "{e}"
     );
-    let e = error(&gradient(r#"<stop id="s" path="z"/>"#));
+    let e = left_out(&gradient(r#"<stop id="s" path="z"/>"#));
     assert!(e.contains("\"z\" is not one l, L, c or C command"), "{e}");
-    let e = error(&gradient(r#"<stop path="c 1,2"/>"#));
+    let e = left_out(&gradient(r#"<stop path="c 1,2"/>"#));
     assert!(
         e.ends_with("path \"c 1,2\": c takes 6 numbers, found 2"),
         "{e}"
     );
-    let e = error(&gradient(r#"<stop path="l 1e999,0"/>"#));
+    let e = left_out(&gradient(r#"<stop path="l 1e999,0"/>"#));
     assert!(
         e.ends_with("path \"l 1e999,0\" is not one l, L, c or C command"),
         "{e}"
@@ -322,30 +332,33 @@ fn errors_name_the_element_and_its_place() {
         e.ends_with("its mesh or outline has coordinates too large to represent"),
         "{e}"
     );
-    let e = error(&gradient(r#"<stop path="l 1,0" stop-color="nocolour"/>"#));
+    let e = left_out(&gradient(r#"<stop path="l 1,0" stop-color="nocolour"/>"#));
     assert!(e.contains("stop-color \"nocolour\" is not a colour"), "{e}");
     // A second line: the line is counted.
-    let e = error(&gradient(
+    let e = left_out(&gradient(
         r#"<stop path="l 1,0"/>
 <stop path="l 0,1" stop-opacity="NaN"/>"#,
     ));
-    assert!(e.starts_with("2: <stop> at column 1: stop-opacity"), "{e}");
+    assert!(
+        e.contains("fill is left out: line 2: <stop> at column 1: stop-opacity"),
+        "{e}"
+    );
 }
 
 #[test]
-fn references_loops_and_entities_are_refused() {
-    let e = error(
+fn reference_loops_leave_the_fill_out_and_entities_are_refused() {
+    let e = left_out(
         r##"<meshgradient id="a" href="#b"/><meshgradient id="b" href="#a"/><rect width="1" height="1" fill="url(#a)"/>"##,
     );
     assert!(
         e.contains(r#"<meshgradient id="a">"#) && e.ends_with("its href chain loops back to #a"),
         "{e}"
     );
-    let e = error(
+    let e = left_out(
         r##"<meshgradient id="a" href="other.svg#b"/><rect width="1" height="1" fill="url(#a)"/>"##,
     );
     assert!(e.ends_with("href \"other.svg#b\" is not a reference into this file (#id); other files are never read"), "{e}");
-    let e = error(
+    let e = left_out(
         r##"<meshgradient id="a" href="#nothing"/><rect width="1" height="1" fill="url(#a)"/>"##,
     );
     assert!(
@@ -440,7 +453,7 @@ fn limits_are_checked_before_the_mesh_is_built() {
 
 #[test]
 fn rows_must_have_the_same_length() {
-    let e = error(
+    let e = left_out(
         r##"<meshgradient id="m"><meshrow><meshpatch/><meshpatch/></meshrow><meshrow id="r"><meshpatch/></meshrow></meshgradient><rect width="1" height="1" fill="url(#m)"/>"##,
     );
     assert!(e.contains(r#"<meshrow id="r">"#) && e.ends_with("the row has 1 patches, but the first row has 2; every row must have the same number"), "{e}");
@@ -577,5 +590,129 @@ fn a_file_without_mesh_fills_is_an_error() {
     assert_eq!(
         e.to_string(),
         "the SVG document: no shape is filled with a mesh gradient"
+    );
+}
+
+#[test]
+fn invalid_attributes_are_ignored_with_a_warning() {
+    let scene = read(&format!(
+        r##"{}
+<rect x="110" y="10" width="80" height="80" opacity="1x"/>
+<rect width="5" height="5" fill="url(#m)" transform="qwe" fill-opacity="half"/>"##,
+        square_gradient("m", 0.0, 0.0, 10.0, "")
+    ));
+    assert_eq!(scene.fills.len(), 1);
+    assert_eq!(scene.fills[0].fill_opacity, 1.0);
+    assert_eq!(
+        scene.fills[0].clip.bounding_box(),
+        Rect::new(0.0, 0.0, 5.0, 5.0)
+    );
+    let all = scene.warnings.join("\n");
+    for expected in [
+        r#"<rect> at 5:1: opacity "1x" is not a number"#,
+        r#"<rect> at 6:1: transform "qwe" is not a transform list"#,
+        r#"<rect> at 6:1: fill-opacity "half" is not a number"#,
+    ] {
+        assert!(all.contains(expected), "{expected} in {all}");
+    }
+    assert_eq!(all.matches(": ignored").count(), 3, "{all}");
+    // The root's invalid width is ignored too: the view box gives the size.
+    let text = format!(
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="wide" viewBox="0 0 40 20">{}<rect width="5" height="5" fill="url(#m)"/></svg>"#,
+        square_gradient("m", 0.0, 0.0, 10.0, "")
+    );
+    let scene = read_svg(&text).unwrap();
+    assert_eq!(scene.pixel_size(), (40.0, 20.0));
+    assert!(
+        scene.warnings[0].contains(r#"width "wide" is not a length"#),
+        "{:?}",
+        scene.warnings
+    );
+}
+
+/// The root's `preserveAspectRatio` fits the view box into the picture: `meet` grows the view
+/// to fill it, `slice` cuts the view box, `none` stretches it.
+#[test]
+fn preserve_aspect_ratio_fits_the_view_box() {
+    let view = |aspect: &str| {
+        let text = format!(
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="100" viewBox="0 0 200 200" {aspect}>{}<rect width="5" height="5" fill="url(#m)"/></svg>"#,
+            square_gradient("m", 0.0, 0.0, 10.0, "")
+        );
+        read_svg(&text).unwrap().view_rect()
+    };
+    let r = |x0, y0, x1, y1| Rect::new(x0, y0, x1, y1);
+    assert_eq!(view(""), r(-100.0, 0.0, 300.0, 200.0));
+    assert_eq!(
+        view(r#"preserveAspectRatio="xMidYMid meet""#),
+        r(-100.0, 0.0, 300.0, 200.0)
+    );
+    assert_eq!(
+        view(r#"preserveAspectRatio="xMinYMin""#),
+        r(0.0, 0.0, 400.0, 200.0)
+    );
+    assert_eq!(
+        view(r#"preserveAspectRatio="xMaxYMax meet""#),
+        r(-200.0, 0.0, 200.0, 200.0)
+    );
+    assert_eq!(
+        view(r#"preserveAspectRatio="xMidYMid slice""#),
+        r(0.0, 50.0, 200.0, 150.0)
+    );
+    assert_eq!(
+        view(r#"preserveAspectRatio="xMinYMin slice""#),
+        r(0.0, 0.0, 200.0, 100.0)
+    );
+    assert_eq!(
+        view(r#"preserveAspectRatio="xMaxYMax slice""#),
+        r(0.0, 100.0, 200.0, 200.0)
+    );
+    assert_eq!(
+        view(r#"preserveAspectRatio="none""#),
+        r(0.0, 0.0, 200.0, 200.0)
+    );
+    // Invalid: the initial value, with a warning.
+    assert_eq!(
+        view(r#"preserveAspectRatio="sideways""#),
+        r(-100.0, 0.0, 300.0, 200.0)
+    );
+    // Aspect ratios a millionth apart (an editor's rounding) show the view box itself.
+    let b = r(0.0, 0.0, 600.00005, 399.99998);
+    assert_eq!(AspectRatio::default().fit(b, 600.0, 400.0), b);
+}
+
+/// A root without a size (or a zero one) has CSS's default size, 300 x 150, unless its view
+/// box gives the size or the ratio.
+#[test]
+fn a_missing_or_zero_size_is_the_css_default_or_the_view_box() {
+    let size = |attributes: &str| {
+        let text = format!(
+            r#"<svg xmlns="http://www.w3.org/2000/svg" {attributes}>{}<rect width="5" height="5" fill="url(#m)"/></svg>"#,
+            square_gradient("m", 0.0, 0.0, 10.0, "")
+        );
+        let scene = read_svg(&text).unwrap();
+        (scene.pixel_size(), scene.view_rect())
+    };
+    let r = |x0, y0, x1, y1| Rect::new(x0, y0, x1, y1);
+    assert_eq!(size(""), ((300.0, 150.0), r(0.0, 0.0, 300.0, 150.0)));
+    assert_eq!(
+        size(r#"width="0" height="0""#),
+        ((300.0, 150.0), r(0.0, 0.0, 300.0, 150.0))
+    );
+    assert_eq!(
+        size(r#"width="50""#),
+        ((50.0, 150.0), r(0.0, 0.0, 50.0, 150.0))
+    );
+    assert_eq!(
+        size(r#"viewBox="0 0 40 20""#),
+        ((40.0, 20.0), r(0.0, 0.0, 40.0, 20.0))
+    );
+    assert_eq!(
+        size(r#"width="80" viewBox="0 0 40 20""#),
+        ((80.0, 40.0), r(0.0, 0.0, 40.0, 20.0))
+    );
+    assert_eq!(
+        size(r#"height="0" viewBox="0 0 40 20""#),
+        ((40.0, 20.0), r(0.0, 0.0, 40.0, 20.0))
     );
 }

@@ -443,17 +443,16 @@ pub fn parse_svg(data: &[u8]) {
 }
 
 /// The reader's guarantees: every number finite; every mesh a full grid of at least one patch
-/// whose sides start and end at their corners; colours and opacities in 0..1; a view box, when
-/// there is one, with a positive size.
+/// whose sides start and end at their corners; colours and opacities in 0..1; a view with a
+/// positive size.
 pub fn check_scene(scene: &formats::svg::SvgScene) {
     let finite = |p: kurbo::Point| p.x.is_finite() && p.y.is_finite();
     let unit = |x: f64| (0.0..=1.0).contains(&x);
-    if let Some(view) = scene.view_rect() {
-        assert!(
-            view.width() > 0.0 && view.height() > 0.0 && finite(view.origin()),
-            "view box {view:?}"
-        );
-    }
+    let view = scene.view_rect();
+    assert!(
+        view.width() > 0.0 && view.height() > 0.0 && finite(view.origin()),
+        "view {view:?}"
+    );
     for fill in &scene.fills {
         let grid = &fill.mesh;
         let (rows, columns) = (grid.rows, grid.columns);
