@@ -24,6 +24,7 @@ async fn mesh_tools_and_tracing_in_a_real_browser() {
         file: None,
         folder: Some(dir.path().to_path_buf()),
         port: 0,
+        ..Config::default()
     })
     .await
     .unwrap();
