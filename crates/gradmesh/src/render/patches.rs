@@ -71,7 +71,8 @@ pub(crate) fn prepare(
     let chunks = patches
         .par_iter()
         .zip(&fill.patches)
-        .map(|(pixel, patch)| pixel.triangles(patch, fill, n, size))
+        .enumerate()
+        .map(|(index, (pixel, patch))| pixel.triangles((index, patch), fill, n, size))
         .collect();
     let triangles = TriangleList::from_chunks(chunks);
     let bands = (opts.height as usize).div_ceil(BAND);
@@ -89,7 +90,7 @@ pub(crate) fn prepare(
         .collect();
     let segments = outer
         .iter()
-        .flat_map(|&(p, s)| side_segments(&patches[p], &fill.patches[p], fill, s, n))
+        .flat_map(|&(p, s)| side_segments(&patches[p], (p, &fill.patches[p]), fill, s, n))
         .collect();
     let (lines, line_bins, columns) = visible_outline(lines, opts, bands);
     let info = LayerInfo {
@@ -204,7 +205,7 @@ impl PixelPatch {
     /// control points all lie beside the image.
     fn triangles(
         &self,
-        patch: &Patch,
+        (index, patch): (usize, &Patch),
         fill: &ShadingFill,
         n: usize,
         size: (i64, i64),
@@ -220,8 +221,9 @@ impl PixelPatch {
         }
         let vertex = |a: usize, b: usize| {
             let p = self.position(a, b, n);
-            let c = fill.srgb_at(patch, a as f64 / n as f64, b as f64 / n as f64);
-            ([p.x, p.y], [c[0], c[1], c[2], fill.opacity])
+            let (u, v) = (a as f64 / n as f64, b as f64 / n as f64);
+            let c = fill.srgb_at(patch, u, v);
+            ([p.x, p.y], [c[0], c[1], c[2], fill.opacity_at(index, u, v)])
         };
         let mut row: Vec<([f64; 2], [f64; 4])> = (0..=n).map(|a| vertex(a, 0)).collect();
         let mut out = Vec::with_capacity(2 * n * n);
@@ -322,7 +324,7 @@ fn side_lines(side: &[Point; 4]) -> Vec<Line> {
 /// whose centre no triangle covers.
 fn side_segments(
     pixel: &PixelPatch,
-    patch: &Patch,
+    (index, patch): (usize, &Patch),
     fill: &ShadingFill,
     s: usize,
     n: usize,
@@ -338,11 +340,10 @@ fn side_segments(
         .map(|k| {
             let (a, b) = step(k);
             let p = pixel.position(a, b, n);
-            let c = fill.srgb_at(patch, a as f64 / n as f64, b as f64 / n as f64);
-            (
-                [p.x, p.y],
-                [c[0], c[1], c[2], fill.opacity].map(|x| x as f32),
-            )
+            let (u, v) = (a as f64 / n as f64, b as f64 / n as f64);
+            let c = fill.srgb_at(patch, u, v);
+            let alpha = fill.opacity_at(index, u, v);
+            ([p.x, p.y], [c[0], c[1], c[2], alpha].map(|x| x as f32))
         })
         .collect();
     vertices

@@ -398,7 +398,7 @@ fn examples_match_the_render_in_every_pdf_renderer() {
 }
 
 /// A layer whose opacity falls from 1 to 0.2 across it, over an opaque layer.
-fn translucent_document() -> Document {
+pub(crate) fn translucent_document() -> Document {
     let mut back = GradientMesh::new(ColourSpace::Lab);
     let p = [(3.3, 2.7), (197.1, 1.9), (198.9, 197.7), (2.1, 198.3)]
         .map(|(x, y)| back.add_point(Point::new(x, y), [30.0, 0.0, -40.0]));

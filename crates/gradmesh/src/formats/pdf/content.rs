@@ -3,6 +3,7 @@
 //! and form XObjects.
 
 use std::collections::BTreeMap;
+use std::rc::Rc;
 
 use kurbo::{Affine, BezPath, ParamCurve, Point, Rect, Shape};
 use lopdf::content::Content;
@@ -31,8 +32,18 @@ struct State {
     /// The pattern of `scn`, when the fill colour space is `Pattern`.
     fill_pattern: Option<Vec<u8>>,
     fill_is_pattern_space: bool,
-    /// Whether a soft mask is set (`SMask` other than `None`), and the object that sets it.
-    soft_mask: Option<String>,
+    /// The soft mask (`SMask` other than `None`).
+    soft_mask: Option<SoftMask>,
+}
+
+/// A soft mask of the graphics state.
+#[derive(Clone)]
+enum SoftMask {
+    /// A luminosity mask whose group paints one grey patch-mesh shading (in picture units):
+    /// the opacity of a shading of the same patches.
+    Shading(Rc<ShadingFill>),
+    /// Another mask, named by the graphics state that sets it: not applied.
+    Other(String),
 }
 
 /// What the interpretation collects.
@@ -310,9 +321,7 @@ impl<'a> Interpreter<'a> {
         if read.background {
             self.note(format!("{what}: the Background is not painted"));
         }
-        if let Some(mask) = &state.soft_mask {
-            self.note(format!("{mask}: the soft mask is not applied"));
-        }
+        let mask = state.soft_mask.clone();
         let mut patches = read.patches;
         for patch in &mut patches {
             for p in patch.points.iter_mut().flatten() {
@@ -331,8 +340,22 @@ impl<'a> Interpreter<'a> {
             colour: read.colour,
             clip: None,
             opacity: state.fill_alpha.clamp(0.0, 1.0),
+            corner_opacity: None,
         };
         let bounds = fill.control_bounds();
+        match mask {
+            Some(SoftMask::Shading(mask)) => match mask_opacity(&mask, &fill) {
+                Some(opacity) => fill.corner_opacity = Some(opacity),
+                None => self.note(format!(
+                    "{what}: the soft mask's shading ({}) has other patches: not applied",
+                    mask.object
+                )),
+            },
+            Some(SoftMask::Other(label)) => {
+                self.note(format!("{label}: the soft mask is not applied"))
+            }
+            None => {}
+        }
         clips.retain(|(path, _)| !rectangle_holding(path, bounds));
         if clips.len() > 1 {
             self.note(format!(
@@ -374,10 +397,53 @@ impl<'a> Interpreter<'a> {
         if let Some(mask) = self.objects.get(dict, b"SMask", &label)? {
             state.soft_mask = match mask {
                 Object::Name(n) if n == b"None" => None,
-                _ => Some(label),
+                _ => Some(self.soft_mask(mask, &label, state, resources)?),
             };
         }
         Ok(())
+    }
+
+    /// The soft mask `mask` of the graphics state `label`, set with `state`: a luminosity mask
+    /// whose group paints exactly one grey patch-mesh shading is kept with that shading.
+    fn soft_mask(
+        &mut self,
+        mask: &'a Object,
+        label: &str,
+        state: &State,
+        resources: Option<&'a Dictionary>,
+    ) -> Result<SoftMask, Error> {
+        let dict = self.objects.dict(mask, label)?;
+        let kind = self.objects.get(dict, b"S", label)?;
+        let luminosity = kind.map(|k| self.objects.name(k, label)).transpose()?
+            == Some(b"Luminosity".as_slice());
+        let group = match dict.get(b"G") {
+            Ok(g) if luminosity => g,
+            _ => return Ok(SoftMask::Other(label.to_string())),
+        };
+        let mut inner = Interpreter {
+            objects: self.objects,
+            limits: self.limits,
+            fills: Vec::new(),
+            notes: BTreeMap::new(),
+            forms: self.forms.clone(),
+            patches: self.patches,
+        };
+        let plain = State {
+            soft_mask: None,
+            fill_alpha: 1.0,
+            ..state.clone()
+        };
+        inner.run_form(group, &format!("{label} /SMask /G"), &plain, resources)?;
+        self.patches = inner.patches;
+        match inner.fills.pop() {
+            Some(fill)
+                if inner.fills.is_empty()
+                    && fill.colour.space == super::colour::PdfColourSpace::Gray =>
+            {
+                Ok(SoftMask::Shading(Rc::new(fill)))
+            }
+            _ => Ok(SoftMask::Other(label.to_string())),
+        }
     }
 
     /// `Do`: a form XObject is run with its matrix, resources and bounding box.
@@ -390,6 +456,19 @@ impl<'a> Interpreter<'a> {
     ) -> Result<(), Error> {
         let object = resource(self.objects, resources, b"XObject", name, what)?;
         let label = label_of(object, name);
+        self.run_form(object, &label, state, resources)
+    }
+
+    /// Runs the form XObject `object` (`label` names it) with its matrix, resources and
+    /// bounding box; an image is counted as left out.
+    fn run_form(
+        &mut self,
+        object: &'a Object,
+        label: &str,
+        state: &State,
+        resources: Option<&'a Dictionary>,
+    ) -> Result<(), Error> {
+        let label = label.to_string();
         let (resolved, id) = self.objects.resolve(object, &label)?;
         let stream = self.objects.stream(resolved, &label)?;
         let subtype = self.objects.get(&stream.dict, b"Subtype", &label)?;
@@ -440,6 +519,30 @@ impl<'a> Interpreter<'a> {
         self.forms.pop();
         result
     }
+}
+
+/// The opacity of the corners of every patch of `fill` from the grey shading `mask`, when it
+/// has the same patches (corners within a millionth of the mesh's size).
+fn mask_opacity(mask: &ShadingFill, fill: &ShadingFill) -> Option<Vec<[f64; 4]>> {
+    if mask.patches.len() != fill.patches.len() {
+        return None;
+    }
+    let bounds = fill.control_bounds();
+    let tolerance = 1e-6 * bounds.width().max(bounds.height()).max(1.0);
+    let n = mask.colour.corner_components();
+    mask.patches
+        .iter()
+        .zip(&fill.patches)
+        .map(|(m, f)| {
+            let corners = [(0, 0), (0, 3), (3, 0), (3, 3)];
+            let same = corners
+                .iter()
+                .all(|&(i, j)| m.points[i][j].distance(f.points[i][j]) <= tolerance);
+            same.then(|| {
+                std::array::from_fn(|c| mask.colour.to_srgb(&m.components[c * n..c * n + n])[0])
+            })
+        })
+        .collect()
 }
 
 /// The number of operands of a path construction operator.

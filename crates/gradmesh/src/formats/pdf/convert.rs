@@ -80,11 +80,12 @@ pub fn fill_to_layer(fill: &ShadingFill, space: ColourSpace) -> (GradientMesh, V
         };
         // Around the patch: (0, 0), (0, 1), (1, 1), (1, 0), with the sides between them.
         let p = &patch.points;
+        let opacity_at = |u: f64, v: f64| fill.opacity_at(index, u, v);
         let mut corners = [
-            (p[0][0], colour_at(0)),
-            (p[0][3], colour_at(1)),
-            (p[3][3], colour_at(3)),
-            (p[3][0], colour_at(2)),
+            (p[0][0], colour_at(0), opacity_at(0.0, 0.0)),
+            (p[0][3], colour_at(1), opacity_at(0.0, 1.0)),
+            (p[3][3], colour_at(3), opacity_at(1.0, 1.0)),
+            (p[3][0], colour_at(2), opacity_at(1.0, 0.0)),
         ];
         let mut curves = patch.sides().to_vec();
         if patch.corner_area() < 0.0 {
@@ -103,26 +104,28 @@ pub fn fill_to_layer(fill: &ShadingFill, space: ColourSpace) -> (GradientMesh, V
                 .flat_map(|i| (1..3).map(move |j| (i, j)))
                 .any(|(i, j)| coons[i][j].distance(p[i][j]) > tolerance * 1e3);
         }
-        let mut shared = |position: Point, colour: [f64; 3], mesh: &mut GradientMesh| {
-            let (kx, ky) = key(position);
-            let same = |q: u32| {
-                let point = &mesh.points[q as usize];
-                point.position.distance(position) <= tolerance
-                    && (0..3).all(|k| (point.colour[k] - colour[k]).abs() <= COLOUR_TOLERANCE)
+        let mut shared =
+            |position: Point, colour: [f64; 3], opacity: f64, mesh: &mut GradientMesh| {
+                let (kx, ky) = key(position);
+                let same = |q: u32| {
+                    let point = &mesh.points[q as usize];
+                    point.position.distance(position) <= tolerance
+                        && (0..3).all(|k| (point.colour[k] - colour[k]).abs() <= COLOUR_TOLERANCE)
+                        && (point.opacity - opacity).abs() <= COLOUR_TOLERANCE
+                };
+                let found = (kx - 1..=kx + 1)
+                    .flat_map(|x| (ky - 1..=ky + 1).map(move |y| (x, y)))
+                    .find_map(|cell| {
+                        at.get(&cell)
+                            .and_then(|list| list.iter().copied().find(|&q| same(q)))
+                    });
+                found.unwrap_or_else(|| {
+                    new_point(mesh, &mut at, key(position), position, colour, opacity)
+                })
             };
-            let found = (kx - 1..=kx + 1)
-                .flat_map(|x| (ky - 1..=ky + 1).map(move |y| (x, y)))
-                .find_map(|cell| {
-                    at.get(&cell)
-                        .and_then(|list| list.iter().copied().find(|&q| same(q)))
-                });
-            found.unwrap_or_else(|| {
-                new_point(mesh, &mut at, key(position), position, colour, fill.opacity)
-            })
-        };
         let mut face: Vec<u32> = corners
             .iter()
-            .map(|&(q, c)| shared(q, c, &mut mesh))
+            .map(|&(q, c, o)| shared(q, c, o, &mut mesh))
             .collect();
         let clashes = (0..face.len()).any(|k| {
             let (a, b) = (face[k], face[(k + 1) % face.len()]);
@@ -133,21 +136,10 @@ pub fn fill_to_layer(fill: &ShadingFill, space: ColourSpace) -> (GradientMesh, V
         if clashes {
             face = corners
                 .iter()
-                .map(|&(q, c)| new_point(&mut mesh, &mut at, key(q), q, c, fill.opacity))
+                .map(|&(q, c, o)| new_point(&mut mesh, &mut at, key(q), q, c, o))
                 .collect();
         }
-        let mut kept: Vec<(u32, [Point; 4])> = Vec::new();
-        for k in 0..4 {
-            if kept.last().map(|l| l.0) != Some(face[k]) {
-                kept.push((face[k], curves[k]));
-            } else if let Some(last) = kept.last_mut() {
-                // A side of no length: the next side starts here.
-                last.1 = curves[k];
-            }
-        }
-        while kept.len() > 1 && kept.first().map(|f| f.0) == kept.last().map(|l| l.0) {
-            kept.pop();
-        }
+        let kept = without_empty_sides(&face, &curves);
         if kept.len() < 3 {
             notes.push(format!(
                 "patch {index} has no area (fewer than three distinct corners): left out"
@@ -175,6 +167,24 @@ pub fn fill_to_layer(fill: &ShadingFill, space: ColourSpace) -> (GradientMesh, V
     }
     mark_kinks(&mut mesh, &sides, &undirected);
     (mesh, notes)
+}
+
+/// The corners of a face with the side that leaves each, corners joined by a side of no
+/// length taken once (with the side that leaves the last of them).
+fn without_empty_sides(face: &[u32], curves: &[[Point; 4]]) -> Vec<(u32, [Point; 4])> {
+    let mut kept: Vec<(u32, [Point; 4])> = Vec::new();
+    for k in 0..4 {
+        if kept.last().map(|l| l.0) != Some(face[k]) {
+            kept.push((face[k], curves[k]));
+        } else if let Some(last) = kept.last_mut() {
+            // A side of no length: the next side starts here.
+            last.1 = curves[k];
+        }
+    }
+    while kept.len() > 1 && kept.first().map(|f| f.0) == kept.last().map(|l| l.0) {
+        kept.pop();
+    }
+    kept
 }
 
 fn new_point(

@@ -52,6 +52,10 @@ pub struct ShadingFill {
     pub clip: Option<(BezPath, FillRule)>,
     /// The constant opacity of the graphics state (`ca`), in 0..1.
     pub opacity: f64,
+    /// The opacity of each patch's corners ((0, 0), (0, 1), (1, 0), (1, 1)) from a luminosity
+    /// soft mask holding one grey shading of the same patches, as gradmesh's export and Cairo
+    /// write them; bilinear in the patch's parameters, times `opacity`.
+    pub corner_opacity: Option<Vec<[f64; 4]>>,
 }
 
 impl ShadingFill {
@@ -63,6 +67,18 @@ impl ShadingFill {
             .flat_map(|p| p.points.iter().flatten().copied());
         let first = points.next().unwrap_or_default();
         points.fold(Rect::from_points(first, first), |r, p| r.union_pt(p))
+    }
+
+    /// The opacity of patch number `index` at parameters `(u, v)`.
+    pub fn opacity_at(&self, index: usize, u: f64, v: f64) -> f64 {
+        match self.corner_opacity.as_ref().and_then(|c| c.get(index)) {
+            Some(o) => {
+                let top = o[0] * (1.0 - v) + o[1] * v;
+                let bottom = o[2] * (1.0 - v) + o[3] * v;
+                self.opacity * (top * (1.0 - u) + bottom * u)
+            }
+            None => self.opacity,
+        }
     }
 
     /// The sRGB colour (gamma-encoded, 0..1) of patch `patch` at parameters `(u, v)`: the
