@@ -1,11 +1,16 @@
-//! The editor's edit path on the Tucan artwork (six layers) in a 1024-pixel-wide view: from
-//! the command text reaching the session to the frame bytes and the state ready to send
-//! (validation, the cached render, the changed rows, the state JSON).
+//! The editor's edit path on the paper authors' Tucan (six layers), Paprika (three) and Glasses
+//! (one mesh, faces up to 14 sides) in a 1024-pixel-wide view: from the command text reaching
+//! the session to the frame bytes and the state ready to send (applying, validation, the cached
+//! render, the changed rows, the state JSON).
 //!
-//! The point edited is the one whose change of colour redraws the most pixels.
+//! For each artwork it edits the costliest points: the drag of the point whose move takes the
+//! longest to render, and the colour change of the point whose change redraws the most pixels.
 //!
-//! `cargo bench -p gradmesh-serve --bench edit_latency`. Besides criterion's figures it prints
-//! the median and worst of one drag of 100 moves and of 100 colour changes.
+//! `cargo bench -p gradmesh-serve --bench edit_latency`. Besides criterion's figures it prints,
+//! per artwork and edit, the median, 95th percentile and worst of 100 steps, and for the drag
+//! the time of each stage of one step. `GRADMESH_LATENCY_STEPS=N` sets the steps,
+//! `GRADMESH_LATENCY_ARTWORKS=glasses,tucan` the artworks; a criterion filter (`-- drag`) runs
+//! criterion alone.
 
 #![allow(missing_docs)] // criterion_group! generates undocumented items.
 
@@ -14,95 +19,169 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, Criterion};
-use gradmesh::render::{self, RenderCache, RenderOptions};
+use gradmesh::render::{self, RenderCache, RenderOptions, View};
 use gradmesh::Document;
 use gradmesh_serve::security::Folder;
 use gradmesh_serve::{App, Editor, History, Outgoing, Picture, Session};
 
-const TUCAN: &str = "../../../shared/realdata/gradientmeshimproved-off";
+const REAL: &str = "../../../shared/realdata/gradientmeshimproved-off";
 const WIDTH: u32 = 1024;
 
-fn tucan() -> Document {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(TUCAN);
-    let layers = (0..6)
-        .rev()
-        .map(|i| {
-            let path = dir.join(format!("Tucan_Tucan_Layer{i}.off"));
+/// The artworks: name and files, the bottom layer first.
+const ARTWORKS: [(&str, &[&str]); 3] = [
+    (
+        "tucan",
+        &[
+            "Tucan_Tucan_Layer5.off",
+            "Tucan_Tucan_Layer4.off",
+            "Tucan_Tucan_Layer3.off",
+            "Tucan_Tucan_Layer2.off",
+            "Tucan_Tucan_Layer1.off",
+            "Tucan_Tucan_Layer0.off",
+        ],
+    ),
+    (
+        "paprika",
+        &[
+            "Paprika_Paprika_layer2.off",
+            "Paprika_Paprika_layer1.off",
+            "Paprika_Paprika_layer0.off",
+        ],
+    ),
+    ("glasses", &["Glasses.off"]),
+];
+
+fn artwork(files: &[&str]) -> Document {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(REAL);
+    let layers = files
+        .iter()
+        .map(|name| {
+            let path = dir.join(name);
             let doc = gradmesh::formats::read_path(&path)
-                .unwrap_or_else(|e| panic!("the Tucan artwork ({}): {e}", path.display()));
+                .unwrap_or_else(|e| panic!("the artwork file {}: {e}", path.display()));
             doc.layers.into_iter().next().expect("one layer")
         })
         .collect();
     Document { layers }
 }
 
-/// The layer and point whose change of colour redraws the most pixels of the picture (through
-/// a `RenderCache`, as the editor renders): the costliest point to edit.
-fn costliest_point(doc: &Document, opts: &RenderOptions) -> (usize, usize) {
+/// The options of the editor's view of `doc`, 1024 pixels wide.
+fn options(doc: &Document) -> RenderOptions {
+    let bounds = View::fit(doc, 0.02);
+    let height = (WIDTH as f64 * bounds.height() / bounds.width()).round() as u32;
+    RenderOptions::new(WIDTH, height, bounds)
+}
+
+/// A layer and point of the artwork.
+#[derive(Clone, Copy, Debug)]
+struct Target {
+    layer: usize,
+    point: usize,
+}
+
+/// The point whose change of colour redraws the most pixels, and the point whose move (by 2
+/// units, as a drag step) takes the longest to render, each through a `RenderCache` as the
+/// editor renders (the quicker of two tries, against interference).
+fn costliest_points(doc: &Document, opts: &RenderOptions) -> (Target, Target) {
     let mut cache = RenderCache::new();
     let mut pixels = vec![0u8; 4 * opts.width as usize * opts.height as usize];
-    render::render_document_into_cached(doc, opts, &mut cache, &mut pixels).expect("renders");
-    let mut best = (0, 0, 0);
+    let mut render = |d: &Document, cache: &mut RenderCache| {
+        render::render_document_into_cached(d, opts, cache, &mut pixels).expect("renders")
+    };
+    render(doc, &mut cache);
+    let mut colour = (0, Target { layer: 0, point: 0 });
+    let mut drag = (Duration::ZERO, Target { layer: 0, point: 0 });
     let mut edited = doc.clone();
     for layer in 0..doc.layers.len() {
         for point in 0..doc.layers[layer].points.len() {
+            let target = Target { layer, point };
             edited.layers[layer].points[point].colour[0] += 30.0;
-            let info = render::render_document_into_cached(&edited, opts, &mut cache, &mut pixels)
-                .expect("renders");
+            let info = render(&edited, &mut cache);
             edited.layers[layer].points[point].colour[0] -= 30.0;
-            if info.drawn_pixels > best.0 {
-                best = (info.drawn_pixels, layer, point);
+            render(&edited, &mut cache);
+            if info.drawn_pixels > colour.0 {
+                colour = (info.drawn_pixels, target);
+            }
+            let mut quickest = Duration::MAX;
+            for _ in 0..2 {
+                edited.layers[layer].points[point].position.x += 2.0;
+                let start = Instant::now();
+                render(&edited, &mut cache);
+                quickest = quickest.min(start.elapsed());
+                edited.layers[layer].points[point].position.x -= 2.0;
+                render(&edited, &mut cache);
+            }
+            if quickest > drag.0 {
+                drag = (quickest, target);
             }
         }
     }
-    (best.1, best.2)
+    (drag.1, colour.1)
 }
 
-/// A session showing the Tucan at 1024 pixels wide, its first frame drawn; the layer and point
-/// to edit ([`costliest_point`]).
-fn tucan_session() -> (Session, usize, usize) {
-    let doc = tucan();
-    let bounds = render::View::fit(&doc, 0.02);
-    let height = (WIDTH as f64 * bounds.height() / bounds.width()).round() as u32;
-    let (layer, point) = costliest_point(&doc, &RenderOptions::new(WIDTH, height, bounds));
+/// A session showing `doc` at 1024 pixels wide, its first frame drawn.
+fn session(doc: &Document) -> Session {
+    let opts = options(doc);
     let folder = Folder::new(&std::env::temp_dir()).expect("temp folder");
     let editor = Editor {
-        history: History::new(Picture::new(doc)),
+        history: History::new(Picture::new(doc.clone())),
         path: None,
     };
     let app = Arc::new(App::new(editor, folder));
     let mut session = Session::new(app);
+    let v = opts.view;
     let view = format!(
-        r#"{{"type":"view","width":{WIDTH},"height":{height},"view":[{},{},{},{}]}}"#,
-        bounds.x0, bounds.y0, bounds.x1, bounds.y1
+        r#"{{"type":"view","width":{},"height":{},"view":[{},{},{},{}]}}"#,
+        opts.width, opts.height, v.x0, v.y0, v.x1, v.y1
     );
     let first = session.handle_texts(&[view]);
     assert!(first.iter().any(|m| matches!(m, Outgoing::Binary(_))));
-    (session, layer, point)
+    session
 }
 
-fn drag_command(layer: usize, point: usize, step: usize) -> String {
+fn drag_command(t: Target, step: usize) -> String {
     // Back and forth by up to 3 units (a few pixels), as a mouse drag does.
     let dx = 3.0 * ((step % 8) as f64 / 4.0 - 1.0);
     format!(
-        r#"{{"type":"edit","gesture":1,"op":{{"op":"move_points","layer":{layer},"points":[{point}],"dx":{dx},"dy":{}}}}}"#,
+        r#"{{"type":"edit","gesture":1,"op":{{"op":"move_points","layer":{},"points":[{}],"dx":{dx},"dy":{}}}}}"#,
+        t.layer,
+        t.point,
         dx / 2.0
     )
 }
 
-fn colour_command(layer: usize, point: usize, step: usize) -> String {
+fn colour_command(t: Target, step: usize) -> String {
     let css = ["#d04020", "#2060c0", "#40a040"][step % 3];
     format!(
-        r#"{{"type":"edit","gesture":2,"op":{{"op":"set_colour","layer":{layer},"points":[{point}],"css":"{css}"}}}}"#
+        r#"{{"type":"edit","gesture":2,"op":{{"op":"set_colour","layer":{},"points":[{}],"css":"{css}"}}}}"#,
+        t.layer, t.point
     )
 }
 
-/// Runs `command(step)` for 100 steps and prints the median and worst time of one step.
-fn report_100(name: &str, command: fn(usize, usize, usize) -> String) {
-    let (mut session, layer, point) = tucan_session();
-    let mut times: Vec<Duration> = (0..100)
+/// The artworks to measure: those named in `GRADMESH_LATENCY_ARTWORKS` (comma-separated), or
+/// all.
+fn chosen() -> Vec<(&'static str, &'static [&'static str])> {
+    let names = std::env::var("GRADMESH_LATENCY_ARTWORKS").unwrap_or_default();
+    (ARTWORKS.into_iter())
+        .filter(|(name, _)| names.is_empty() || names.split(',').any(|n| n == *name))
+        .collect()
+}
+
+fn steps() -> usize {
+    std::env::var("GRADMESH_LATENCY_STEPS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(100)
+}
+
+/// Runs `command(target, step)` for the steps and prints the median, 95th percentile and worst
+/// time of one step.
+fn report(name: &str, edit: &str, doc: &Document, t: Target, command: fn(Target, usize) -> String) {
+    let mut session = session(doc);
+    let n = steps();
+    let mut times: Vec<Duration> = (0..n)
         .map(|step| {
-            let text = command(layer, point, step + 1);
+            let text = command(t, step + 1);
             let start = Instant::now();
             let out = session.handle_texts(&[text]);
             let elapsed = start.elapsed();
@@ -111,39 +190,112 @@ fn report_100(name: &str, command: fn(usize, usize, usize) -> String) {
         })
         .collect();
     times.sort();
+    let ms = |d: Duration| d.as_secs_f64() * 1e3;
     println!(
-        "{name}: 100 edits of point {point} of layer {layer} of the Tucan at {WIDTH} px wide: \
-         median {:.2} ms, worst {:.2} ms",
-        times[50].as_secs_f64() * 1e3,
-        times[99].as_secs_f64() * 1e3
+        "{name} {edit} (layer {}, point {}), {n} steps at {WIDTH} px: median {:.2} ms, 95th {:.2} ms, worst {:.2} ms",
+        t.layer,
+        t.point,
+        ms(times[n / 2]),
+        ms(times[(n * 95 / 100).min(n - 1)]),
+        ms(times[n - 1])
+    );
+}
+
+/// The stages of one drag step, timed apart (the medians of the steps): applying the move and
+/// validating the changed layer (`History::apply`), the document of the visible layers (a
+/// copy), the cached render (with the renderer's own prepare and draw times), and the whole
+/// step through the session (the rest: the changed rows, the frame, the state JSON).
+fn profile_drag(name: &str, doc: &Document, t: Target) {
+    let opts = options(doc);
+    let mut history = History::new(Picture::new(doc.clone()));
+    let mut cache = RenderCache::new();
+    let mut pixels = vec![0u8; 4 * opts.width as usize * opts.height as usize];
+    render::render_document_into_cached(doc, &opts, &mut cache, &mut pixels).expect("renders");
+    let mut session = session(doc);
+    let n = steps();
+    let mut stages: Vec<[Duration; 6]> = Vec::with_capacity(n);
+    for step in 1..=n {
+        let text = drag_command(t, step);
+        let command: gradmesh_serve::Command = serde_json::from_str(&text).expect("a command");
+        let gradmesh_serve::Command::Edit { op, gesture } = command else {
+            unreachable!("an edit")
+        };
+        let start = Instant::now();
+        history.apply(&op, gesture).expect("applies");
+        let applied = start.elapsed();
+        let start = Instant::now();
+        let visible = history.current().visible();
+        let copied = start.elapsed();
+        let start = Instant::now();
+        let info = render::render_document_into_cached(&visible, &opts, &mut cache, &mut pixels)
+            .expect("renders");
+        let rendered = start.elapsed();
+        let start = Instant::now();
+        session.handle_texts(&[text]);
+        let whole = start.elapsed();
+        stages.push([
+            applied,
+            copied,
+            rendered,
+            info.timings.prepare,
+            info.timings.draw,
+            whole,
+        ]);
+    }
+    let median = |k: usize| {
+        let mut v: Vec<Duration> = stages.iter().map(|s| s[k]).collect();
+        v.sort();
+        v[n / 2].as_secs_f64() * 1e3
+    };
+    println!(
+        "{name} drag stages (medians): apply and validate {:.2} ms, copy of the visible layers {:.2} ms, \
+         render {:.2} ms (prepare {:.2}, draw {:.2}); whole step {:.2} ms",
+        median(0),
+        median(1),
+        median(2),
+        median(3),
+        median(4),
+        median(5)
     );
 }
 
 fn edit_latency(c: &mut Criterion) {
-    let mut group = c.benchmark_group("edit_latency_tucan_1024");
-    let (mut session, layer, point) = tucan_session();
-    let mut step = 0;
-    group.bench_function("drag_point", |b| {
-        b.iter(|| {
-            step += 1;
-            session.handle_texts(&[drag_command(layer, point, step)])
-        })
-    });
-    let (mut session, layer, point) = tucan_session();
-    group.bench_function("set_colour", |b| {
-        b.iter(|| {
-            step += 1;
-            session.handle_texts(&[colour_command(layer, point, step)])
-        })
-    });
-    group.finish();
+    for (name, files) in chosen() {
+        let doc = artwork(files);
+        let (drag, colour) = costliest_points(&doc, &options(&doc));
+        let mut group = c.benchmark_group(format!("edit_latency_{name}_1024"));
+        let mut s = session(&doc);
+        let mut step = 0;
+        group.bench_function("drag_point", |b| {
+            b.iter(|| {
+                step += 1;
+                s.handle_texts(&[drag_command(drag, step)])
+            })
+        });
+        let mut s = session(&doc);
+        group.bench_function("set_colour", |b| {
+            b.iter(|| {
+                step += 1;
+                s.handle_texts(&[colour_command(colour, step)])
+            })
+        });
+        group.finish();
+    }
 }
 
 criterion_group!(benches, edit_latency);
 
 fn main() {
-    report_100("drag", drag_command);
-    report_100("colour", colour_command);
+    let criterion_only = std::env::args().skip(1).any(|a| !a.starts_with('-'));
+    if !criterion_only {
+        for (name, files) in chosen() {
+            let doc = artwork(files);
+            let (drag, colour) = costliest_points(&doc, &options(&doc));
+            report(name, "drag", &doc, drag, drag_command);
+            report(name, "colour", &doc, colour, colour_command);
+            profile_drag(name, &doc, drag);
+        }
+    }
     benches();
     Criterion::default().configure_from_args().final_summary();
 }
