@@ -14,6 +14,10 @@ pub struct Cli {
     /// What to do.
     #[command(subcommand)]
     pub command: Command,
+    /// List every warning about the inputs, rather than a count per file (`info` always
+    /// lists them).
+    #[arg(long, global = true)]
+    pub warnings: bool,
 }
 
 /// The subcommands.

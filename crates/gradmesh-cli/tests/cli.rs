@@ -798,3 +798,126 @@ fn info_reports_each_unreadable_file_once() {
     let o = gradmesh(&["info", s(&a)]);
     assert_eq!(stderr(&o).lines().count(), 1, "{}", stderr(&o));
 }
+
+/// The README's first command: the Tucan's six layers.
+fn tucan_layers() -> Vec<PathBuf> {
+    (0..6)
+        .rev()
+        .map(|i| realdata().join(format!("Tucan_Tucan_Layer{i}.off")))
+        .collect()
+}
+
+/// The lines of `text` that are warnings about the file `path`.
+fn warnings_about<'a>(text: &'a str, path: &Path) -> Vec<&'a str> {
+    let prefix = format!("gradmesh: warning: {}: ", path.display());
+    text.lines().filter(|l| l.starts_with(&prefix)).collect()
+}
+
+#[test]
+fn render_counts_the_warnings_of_each_file_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tucan.png");
+    let layers = tucan_layers();
+    let mut args = vec!["render"];
+    args.extend(layers.iter().map(|p| s(p)));
+    args.extend(["-o", s(&out), "--width", "64"]);
+    let quiet = gradmesh(&args);
+    let msg = stderr(&quiet);
+    assert!(quiet.status.success(), "{msg}");
+    assert!(!msg.contains("longer than half its edge"), "{msg}");
+    let mut summarised = 0;
+    for layer in &layers {
+        let lines = warnings_about(&msg, layer);
+        assert!(lines.len() <= 1, "{}: {msg}", layer.display());
+        summarised += lines.len();
+    }
+    assert!(summarised >= 1, "some Tucan layer has warnings: {msg}");
+    assert_eq!(msg.lines().count(), summarised, "{msg}");
+    assert!(
+        msg.lines()
+            .all(|l| l.ends_with(": --warnings to list them")),
+        "{msg}"
+    );
+    assert!(msg.contains("handles may fold"), "{msg}");
+    assert!(msg.contains("1 colour outside sRGB"), "{msg}");
+
+    args.push("--warnings");
+    let listed = gradmesh(&args);
+    let full = stderr(&listed);
+    assert!(listed.status.success(), "{full}");
+    let handles = full.matches("longer than half its edge").count();
+    let gamut = full.matches("outside the sRGB gamut").count();
+    // Each kind's count in the summary is the number of warnings listed.
+    let counted = |what: &str| -> usize {
+        msg.split([',', ':'])
+            .filter_map(|part| part.trim().strip_suffix(what))
+            .map(|n| n.trim().parse::<usize>().unwrap())
+            .sum()
+    };
+    assert_eq!(
+        counted("handles may fold") + counted("handle may fold"),
+        handles,
+        "{msg}\n{full}"
+    );
+    assert_eq!(counted("colour outside sRGB"), gamut, "{msg}\n{full}");
+    assert!(handles > summarised, "{full}");
+    assert_eq!(full.lines().count(), handles + gamut, "{full}");
+    // `info` lists them all without the flag, under their layer.
+    let info_args: Vec<&str> = std::iter::once("info")
+        .chain(layers.iter().map(|p| s(p)))
+        .collect();
+    let info = gradmesh(&info_args);
+    let text = String::from_utf8(info.stdout).unwrap();
+    assert_eq!(
+        text.matches("longer than half its edge").count(),
+        handles,
+        "{text}"
+    );
+}
+
+#[test]
+fn warnings_are_counted_for_convert_and_refine_too() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("long.json");
+    // A quad with a handle longer than half its edge, and a point no face uses.
+    std::fs::write(
+        &input,
+        r##"{"format": "gradmesh", "version": 1, "layers": [{
+            "points": [{"position": [0, 0], "colour": "#ff0000", "handles": [[1, 7, 0]]},
+                       {"position": [10, 0], "colour": "#00ff00"},
+                       {"position": [10, 10], "colour": "#0000ff"}, {"position": [0, 10], "colour": "#ffffff"},
+                       {"position": [20, 20], "colour": "#000000"}],
+            "faces": [[0, 1, 2, 3]]}]}"##,
+    )
+    .unwrap();
+    let json = dir.path().join("out.json");
+    let obj = dir.path().join("out.obj");
+    for args in [
+        vec!["convert", s(&input), "-o", s(&json)],
+        vec!["refine", s(&input), "-o", s(&obj), "--levels", "1"],
+    ] {
+        let o = gradmesh(&args);
+        let msg = stderr(&o);
+        assert!(o.status.success(), "{args:?}: {msg}");
+        assert_eq!(
+            msg.trim_end(),
+            format!(
+                "gradmesh: warning: {}: 1 handle may fold, 1 point on no face: --warnings to list them",
+                input.display()
+            ),
+            "{args:?}"
+        );
+        let mut listing = args.clone();
+        listing.push("--warnings");
+        let msg = stderr(&gradmesh(&listing));
+        assert_eq!(msg.lines().count(), 2, "{args:?}: {msg}");
+        assert!(
+            msg.contains("layer 0: handle of point 0 towards 1 is longer"),
+            "{msg}"
+        );
+        assert!(
+            msg.contains("layer 0: point 4 is not used by any face"),
+            "{msg}"
+        );
+    }
+}

@@ -36,6 +36,7 @@ fn svg_converts_to_json_and_renders() {
         svg.to_str().unwrap(),
         "-o",
         json.to_str().unwrap(),
+        "--warnings",
     ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
@@ -271,6 +272,7 @@ fn whole_picture_against_inkscape(
         sample(&format!("{name}.svg")).to_str().unwrap(),
         "-o",
         out.to_str().unwrap(),
+        "--warnings",
     ]);
     assert!(run.status.success(), "{run:?}");
     let stderr = String::from_utf8_lossy(&run.stderr);
@@ -347,6 +349,7 @@ fn svg_whole_picture_keeps_paint_order() {
             out.to_str().unwrap(),
             "--bits",
             bits,
+            "--warnings",
         ];
         if let Some(bg) = background {
             args.extend(["--background", bg]);

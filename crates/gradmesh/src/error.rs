@@ -236,13 +236,100 @@ impl fmt::Display for Error {
 
 impl std::error::Error for Error {}
 
+/// What kind of thing a [`Warning`] is about, so that a program can count warnings by kind
+/// without reading their text.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[non_exhaustive]
+pub enum WarningKind {
+    /// A handle longer than half its edge: the surface may fold there.
+    HandleMayFold,
+    /// The surface folds over itself (as `render::find_folds` finds).
+    Fold,
+    /// A control point's colour lies outside the sRGB gamut.
+    OutsideGamut,
+    /// A point that no face uses.
+    UnusedPoint,
+    /// A wedge entry on a point that is on no discontinuous edge.
+    WedgeEntryWithoutDiscontinuity,
+    /// Multi-resolution edits below the level written, which have no effect on it.
+    EditsBelowLevel,
+    /// Content of an SVG file that is not a mesh-gradient fill (other shapes, other paints):
+    /// left out of the meshes.
+    SvgNotMeshFill,
+    /// A mesh gradient or one of its patches left out (no area to draw).
+    SvgMeshLeftOut,
+    /// Something in an SVG file ignored or read differently from what it says (an invalid view
+    /// box, an unknown mesh type, extra stops, corners merged).
+    SvgReadDifferently,
+    /// Content of a PDF page that is not a patch-mesh shading, or a shading or part of one
+    /// read differently from what the file says (an unsupported colour space, a second clip).
+    PdfLeftOut,
+}
+
+impl WarningKind {
+    /// `count` warnings of this kind in a few words: "3 handles may fold".
+    pub fn counted(self, count: usize) -> String {
+        let one = count == 1;
+        let (singular, plural) = match self {
+            WarningKind::HandleMayFold => ("handle may fold", "handles may fold"),
+            WarningKind::Fold => ("fold", "folds"),
+            WarningKind::OutsideGamut => ("colour outside sRGB", "colours outside sRGB"),
+            WarningKind::UnusedPoint => ("point on no face", "points on no face"),
+            WarningKind::WedgeEntryWithoutDiscontinuity => (
+                "wedge entry on no discontinuous edge",
+                "wedge entries on no discontinuous edge",
+            ),
+            WarningKind::EditsBelowLevel => (
+                "edit level below the level written",
+                "edit levels below the level written",
+            ),
+            WarningKind::SvgNotMeshFill => (
+                "part that is not a mesh gradient left out",
+                "parts that are not mesh gradients left out",
+            ),
+            WarningKind::SvgMeshLeftOut => ("mesh part left out", "mesh parts left out"),
+            WarningKind::SvgReadDifferently => (
+                "SVG attribute ignored or read differently",
+                "SVG attributes ignored or read differently",
+            ),
+            WarningKind::PdfLeftOut => (
+                "PDF part left out or read differently",
+                "PDF parts left out or read differently",
+            ),
+        };
+        format!("{count} {}", if one { singular } else { plural })
+    }
+}
+
 /// Something legal but suspicious in the input.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Warning {
     /// The layer, when the document has several.
     pub layer: Option<usize>,
+    /// What it is about.
+    pub kind: WarningKind,
     /// What was noticed, naming the element.
     pub message: String,
+    /// How many things of its kind it reports: 1, or more for a warning that sums up the
+    /// rest of a long list ("12 more points ...").
+    pub count: usize,
+}
+
+impl Warning {
+    /// A warning about one thing, in no particular layer.
+    pub fn new(kind: WarningKind, message: impl Into<String>) -> Self {
+        Warning {
+            layer: None,
+            kind,
+            message: message.into(),
+            count: 1,
+        }
+    }
+
+    /// The same warning, standing for `count` things of its kind.
+    pub fn counting(self, count: usize) -> Self {
+        Warning { count, ..self }
+    }
 }
 
 impl fmt::Display for Warning {

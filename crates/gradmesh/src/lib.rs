@@ -59,7 +59,7 @@ mod validate;
 
 pub use colour::{parse_css_colour, ColourSpace};
 pub use edit_check::EditSet;
-pub use error::{Error, ErrorKind, Location, Result, Warning};
+pub use error::{Error, ErrorKind, Location, Result, Warning, WarningKind};
 pub use fit::{
     fit_colours, psnr, vectorise, vectorise_with_progress, Progress, Quality, RgbaImage,
     VectoriseOptions, Vectorised, MAX_IMAGE_BYTES, MAX_IMAGE_PIXELS,

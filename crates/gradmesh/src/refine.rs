@@ -13,7 +13,7 @@ use crate::catmull_clark::{self, Level, Stencils};
 use crate::colour::ColourSpace;
 use crate::edit_check::check_edits;
 use crate::edits;
-use crate::error::{Error, Warning};
+use crate::error::{Error, Warning, WarningKind};
 use crate::limit_surface;
 use crate::mesh::{FirstStep, GradientMesh};
 use crate::multires::{Edit, FineEdits};
@@ -476,13 +476,13 @@ pub fn refine_level(
         LevelPoints::Limit => {
             limits.check_refinement(refinement.base(), level.max(2))?;
         }
-        LevelPoints::Control if deepest_edit > level => warnings.push(Warning {
-            layer: None,
-            message: format!(
+        LevelPoints::Control if deepest_edit > level => warnings.push(Warning::new(
+            WarningKind::EditsBelowLevel,
+            format!(
                 "edits down to level {deepest_edit} lie below the level written ({level}) and \
                  have no effect on it"
             ),
-        }),
+        )),
         LevelPoints::Control => {}
     }
     let mut all = refinement.evaluate();

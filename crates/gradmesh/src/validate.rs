@@ -10,7 +10,7 @@ use std::ops::Range;
 use kurbo::{Point, Vec2};
 
 use crate::edit_check::{check_edits, EditSet};
-use crate::error::{Error, ErrorKind, Warning};
+use crate::error::{Error, ErrorKind, Warning, WarningKind};
 use crate::mesh::{
     edge_key, BoundaryInterpolation, CreasingMethod, EdgeKind, FirstStep, GradientMesh,
 };
@@ -127,7 +127,11 @@ impl BaseMesh {
             apply_wedge_entries(mesh, &whole, &wedges, &mut data, &mut warnings)?;
         // Warned before the split topology is built: a failure there drops every warning.
         for v in (0..n).filter(|&v| whole.vertex_faces(v).is_empty()) {
-            warn(&mut warnings, format!("point {v} is not used by any face"));
+            warn(
+                &mut warnings,
+                WarningKind::UnusedPoint,
+                format!("point {v} is not used by any face"),
+            );
         }
         let Wedges {
             corner_vertex,
@@ -174,11 +178,8 @@ impl BaseMesh {
     }
 }
 
-fn warn(warnings: &mut Vec<Warning>, message: String) {
-    warnings.push(Warning {
-        layer: None,
-        message,
-    })
+fn warn(warnings: &mut Vec<Warning>, kind: WarningKind, message: String) {
+    warnings.push(Warning::new(kind, message))
 }
 
 /// Whether points `a` and `b` are joined by an edge of `whole`: a scan of `a`'s ring (no hash
@@ -261,6 +262,7 @@ fn check_handles(
         if h.hypot() > 0.5 * len * (1.0 + 1e-9) {
             warn(
                 warnings,
+                WarningKind::HandleMayFold,
                 format!(
                     "handle of point {from} towards {to} is longer than half its edge ({:.4} > {:.4}): the surface may fold",
                     h.hypot(),
@@ -467,6 +469,7 @@ fn apply_wedge_entries<'m>(
         if wedges.face_count[id] as usize == whole.vertex_faces(w.point as usize).len() {
             warn(
                 warnings,
+                WarningKind::WedgeEntryWithoutDiscontinuity,
                 format!("{what}: the point is on no discontinuous edge, so the entry recolours it on every side"),
             );
         }
@@ -524,6 +527,7 @@ fn warn_outside_gamut(mesh: &GradientMesh, warnings: &mut Vec<Warning>) {
             if outside <= GAMUT_WARNINGS_LISTED {
                 warn(
                     warnings,
+                    WarningKind::OutsideGamut,
                     format!(
                         "point {v}: colour {:?} ({}) is outside the sRGB gamut",
                         p.colour,
@@ -534,13 +538,9 @@ fn warn_outside_gamut(mesh: &GradientMesh, warnings: &mut Vec<Warning>) {
         }
     }
     if outside > GAMUT_WARNINGS_LISTED {
-        warn(
-            warnings,
-            format!(
-                "{} more points have colours outside the sRGB gamut",
-                outside - GAMUT_WARNINGS_LISTED
-            ),
-        );
+        let more = outside - GAMUT_WARNINGS_LISTED;
+        let message = format!("{more} more points have colours outside the sRGB gamut");
+        warnings.push(Warning::new(WarningKind::OutsideGamut, message).counting(more));
     }
 }
 

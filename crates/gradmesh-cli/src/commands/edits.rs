@@ -7,8 +7,8 @@ use gradmesh::{ColourEdit, Edit, Error, OpacityEdit};
 
 use crate::args::EditsArgs;
 
-pub fn run(args: &EditsArgs) -> Result<(), Error> {
-    let doc = super::read(&args.input, &args.limits.limits(), 1)?;
+pub fn run(args: &EditsArgs, report: &mut super::WarningReport) -> Result<(), Error> {
+    let doc = super::read(&args.input, &args.limits.limits(), 1, report)?;
     let mut out = String::new();
     for (i, mesh) in doc.layers.iter().enumerate() {
         let locate = |e: Error| e.in_layer(i).in_file(&args.input);
@@ -23,7 +23,7 @@ pub fn run(args: &EditsArgs) -> Result<(), Error> {
             continue;
         };
         let (mut refinement, warnings) = Refinement::new(mesh, deepest).map_err(locate)?;
-        super::print_warnings(&args.input, &warnings);
+        report.add(Some(&args.input), super::in_layer(warnings, i));
         let data = refinement.evaluate();
         writeln!(
             out,

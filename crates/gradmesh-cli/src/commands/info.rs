@@ -16,7 +16,10 @@ pub fn run(args: &InfoArgs) -> Result<(), Failure> {
     let mut failed = 0usize;
     let limits = args.limits.limits();
     for path in &args.inputs {
-        match super::read(path, &limits, args.page.page) {
+        let mut read_warnings = super::WarningReport::new(true);
+        let read = super::read(path, &limits, args.page.page, &mut read_warnings);
+        read_warnings.print();
+        match read {
             Ok(doc) => {
                 println!("{}", path.display());
                 for (i, mesh) in doc.layers.iter().enumerate() {
@@ -61,14 +64,14 @@ fn histogram(values: impl Iterator<Item = usize>) -> String {
 fn describe(mesh: &GradientMesh) -> Result<(String, Vec<gradmesh::Warning>), Error> {
     let (base, mut warnings) = BaseMesh::new(mesh)?;
     for fold in gradmesh::render::find_folds(mesh)? {
-        warnings.push(gradmesh::Warning {
-            layer: None,
-            message: format!(
+        warnings.push(gradmesh::Warning::new(
+            gradmesh::WarningKind::Fold,
+            format!(
                 "the surface folds over itself near ({:.1}, {:.1}), in faces {:?} (area {:.3}): \
                  make the mesh more convex there or shorten its handles",
                 fold.position.x, fold.position.y, fold.faces, fold.area
             ),
-        });
+        ));
     }
     let whole = Topology::from_faces(mesh.points.len(), &mesh.faces)?;
     let mut s = String::new();

@@ -8,6 +8,7 @@ mod render;
 mod resvg_guard;
 mod serve;
 mod vectorise;
+mod warnings;
 mod whole_picture;
 
 use std::path::Path;
@@ -15,6 +16,8 @@ use std::path::Path;
 use gradmesh::{Document, Error};
 
 use crate::args::{Cli, Command};
+
+pub use warnings::WarningReport;
 
 /// Why a command failed.
 pub enum Failure {
@@ -30,24 +33,34 @@ impl From<Error> for Failure {
     }
 }
 
-/// Runs the subcommand of `cli`.
+/// Runs the subcommand of `cli`. The warnings about its inputs are printed when it ends (before
+/// its error, if it fails): every one with `--warnings` (and always by `info`), otherwise a
+/// count per file.
 pub fn run(cli: Cli) -> Result<(), Failure> {
-    match cli.command {
+    let mut report = WarningReport::new(cli.warnings);
+    let result = match cli.command {
         Command::Info(a) => info::run(&a),
-        Command::Convert(a) => Ok(convert::run(&a)?),
-        Command::Refine(a) => Ok(refine::run(&a)?),
-        Command::Render(a) => Ok(render::run(&a)?),
-        Command::Edits(a) => Ok(edits::run(&a)?),
+        Command::Convert(a) => Ok(convert::run(&a, &mut report)?),
+        Command::Refine(a) => Ok(refine::run(&a, &mut report)?),
+        Command::Render(a) => Ok(render::run(&a, &mut report)?),
+        Command::Edits(a) => Ok(edits::run(&a, &mut report)?),
         Command::Serve(a) => Ok(serve::run(&a)?),
         Command::Vectorise(a) => Ok(vectorise::run(&a)?),
-    }
+    };
+    report.print();
+    result
 }
 
 /// Reads a document within `limits` (page `page` of a PDF file), with errors located in the
-/// file. An SVG or PDF file's warnings (what was left out) are printed.
-fn read(path: &Path, limits: &gradmesh::Limits, page: usize) -> Result<Document, Error> {
+/// file. An SVG or PDF file's warnings (what was left out) go to `report`.
+fn read(
+    path: &Path,
+    limits: &gradmesh::Limits,
+    page: usize,
+    report: &mut WarningReport,
+) -> Result<Document, Error> {
     let input = read_with_viewport(path, limits, page)?;
-    print_warnings(path, &input.warnings);
+    report.add(Some(path), input.warnings);
     Ok(input.document)
 }
 
@@ -135,9 +148,13 @@ fn check_not_input(output: &Path, inputs: &[&Path], force: bool) -> Result<(), E
     Ok(())
 }
 
-/// Prints warnings to standard error.
-pub(super) fn print_warnings(path: &Path, warnings: &[gradmesh::Warning]) {
-    for w in warnings {
-        eprintln!("gradmesh: warning: {}: {w}", path.display());
-    }
+/// `warnings` of layer `layer`, marked with it.
+fn in_layer(
+    warnings: Vec<gradmesh::Warning>,
+    layer: usize,
+) -> impl Iterator<Item = gradmesh::Warning> {
+    warnings.into_iter().map(move |w| gradmesh::Warning {
+        layer: Some(layer),
+        ..w
+    })
 }

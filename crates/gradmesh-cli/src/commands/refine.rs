@@ -5,7 +5,7 @@ use gradmesh::{refine_level, Error, ErrorKind, LevelPoints, Limits};
 
 use crate::args::RefineArgs;
 
-pub fn run(args: &RefineArgs) -> Result<(), Error> {
+pub fn run(args: &RefineArgs, report: &mut super::WarningReport) -> Result<(), Error> {
     let format = Format::from_path(&args.output)
         .filter(|f| matches!(f, Format::Obj | Format::Json))
         .ok_or_else(|| {
@@ -20,7 +20,7 @@ pub fn run(args: &RefineArgs) -> Result<(), Error> {
         refined_faces: args.max_refined_faces,
         ..args.limits.limits()
     };
-    let mut doc = super::read(&args.input, &limits, 1)?;
+    let mut doc = super::read(&args.input, &limits, 1, report)?;
     args.variant.apply(&mut doc);
     let points = if args.limit {
         LevelPoints::Limit
@@ -29,10 +29,9 @@ pub fn run(args: &RefineArgs) -> Result<(), Error> {
     };
     let mut layers = Vec::with_capacity(doc.layers.len());
     for (i, mesh) in doc.layers.iter().enumerate() {
-        let (level, mut warnings) = refine_level(mesh, args.levels, points, &limits)
+        let (level, warnings) = refine_level(mesh, args.levels, points, &limits)
             .map_err(|e| e.in_layer(i).in_file(&args.input))?;
-        warnings.iter_mut().for_each(|w| w.layer = Some(i));
-        super::print_warnings(&args.input, &warnings);
+        report.add(Some(&args.input), super::in_layer(warnings, i));
         layers.push(level);
     }
     match format {

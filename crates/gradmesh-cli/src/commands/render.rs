@@ -8,11 +8,12 @@ use gradmesh::parse_css_colour;
 use gradmesh::render::{
     self, LayerSource, PictureLayer, PngDepth, RenderOptions, SvgMeshRendering, View,
 };
-use gradmesh::{ColourSpace, Document, Error, ErrorKind};
+use gradmesh::{ColourSpace, Document, Error, ErrorKind, Warning, WarningKind};
 
 use crate::args::RenderArgs;
 
 use super::whole_picture;
+use super::WarningReport;
 
 fn invalid(what: &str, message: String) -> Error {
     Error::new(ErrorKind::Invalid {
@@ -86,7 +87,7 @@ fn output_kind(path: &std::path::Path) -> Option<Output> {
     }
 }
 
-pub fn run(args: &RenderArgs) -> Result<(), Error> {
+pub fn run(args: &RenderArgs, report: &mut WarningReport) -> Result<(), Error> {
     let Some(kind) = output_kind(&args.output) else {
         return Err(invalid(
             "output",
@@ -144,8 +145,8 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
             .iter()
             .any(|f| matches!(f, Some(super::ClassicFill::Svg(_))));
     if !whole {
-        for (path, warnings) in &left_out {
-            super::print_warnings(path, warnings);
+        for (path, warnings) in left_out.iter_mut() {
+            report.add(Some(*path), std::mem::take(warnings));
         }
     }
     if kind != Output::Png {
@@ -155,7 +156,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         let sized_by_flags = args.width.is_some() || args.height.is_some() || args.view.is_some();
         let page_px = viewport.filter(|_| !sized_by_flags).map(|(_, size)| size);
         let output = VectorOutput { pdf, page_px };
-        return vector(args, &doc, &opts, output, &origins, read).map_err(locate);
+        return vector(args, &doc, &opts, output, &origins, read, report).map_err(locate);
     }
     // The image's size and view are checked before its buffer is allocated.
     opts.check()?;
@@ -174,7 +175,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
             let drawn =
                 whole_picture::render_whole_picture((path, &text), layers, &opts, max_memory)
                     .map_err(|e| locate(e).in_file(path))?;
-            print_left_out(path, &left_out[0].1, drawn.is_ok());
+            report.add(Some(path), left_out_of(&mut left_out[0].1, drawn.is_ok()));
             if let Err(message) = &drawn {
                 eprintln!(
                     "gradmesh: warning: {}: only the mesh fills are drawn: {message}",
@@ -205,9 +206,7 @@ pub fn run(args: &RenderArgs) -> Result<(), Error> {
         (Pixels::Eight(data), info)
     };
     let rendered = start.elapsed();
-    for w in &info.warnings {
-        warn(w, &origins);
-    }
+    add_warnings(report, info.warnings, &origins);
 
     // Encoded straight into a temporary file (the PNG is never held in memory), which is
     // synced to disk and then replaces the output.
@@ -296,15 +295,12 @@ fn picture_layers<'a>(
     })
 }
 
-/// Prints what an SVG file's reading left out, except the content resvg drew (`drawn`).
-fn print_left_out(path: &std::path::Path, warnings: &[gradmesh::Warning], drawn: bool) {
-    for w in warnings {
-        // The reader's words for content with other paints and elements other than shapes.
-        let resvg_draws_it = w.message.contains("left out: only");
-        if !(drawn && resvg_draws_it) {
-            eprintln!("gradmesh: warning: {}: {w}", path.display());
-        }
-    }
+/// What an SVG file's reading left out (`warnings`, emptied), except the content resvg drew
+/// (`drawn`): what is not a mesh-gradient fill.
+fn left_out_of(warnings: &mut Vec<Warning>, drawn: bool) -> Vec<Warning> {
+    let mut warnings = std::mem::take(warnings);
+    warnings.retain(|w| !(drawn && w.kind == WarningKind::SvgNotMeshFill));
+    warnings
 }
 
 /// Draws `picture` when there is one, else `doc`, into `out`.
@@ -335,6 +331,7 @@ fn vector(
     VectorOutput { pdf, page_px }: VectorOutput,
     origins: &[(&std::path::Path, usize)],
     read: std::time::Duration,
+    report: &mut WarningReport,
 ) -> Result<(), Error> {
     warn_of_png_flags(args);
     let mut opts = ExportOptions::new(render.width, render.height, render.view);
@@ -350,9 +347,7 @@ fn vector(
         export::write_svg(doc, &opts, !args.no_fallback)?
     };
     let made = start.elapsed();
-    for w in &info.warnings {
-        warn(w, origins);
-    }
+    add_warnings(report, info.warnings, origins);
     let start = Instant::now();
     formats::write_atomic(&args.output, &bytes)?;
     if args.timings {
@@ -408,15 +403,24 @@ fn warn_of_png_flags(args: &RenderArgs) {
     }
 }
 
-/// Prints warning `w`, naming the file and layer its layer came from (`origins`).
-fn warn(w: &gradmesh::Warning, origins: &[(&std::path::Path, usize)]) {
-    match w.layer.and_then(|l| origins.get(l)) {
-        Some(&(path, i)) => eprintln!(
-            "gradmesh: warning: {}: layer {i}: {}",
-            path.display(),
-            w.message
-        ),
-        None => eprintln!("gradmesh: warning: {w}"),
+/// Adds `warnings` (about layers of the document) to `report`, each about the file and layer
+/// its layer came from (`origins`).
+fn add_warnings(
+    report: &mut WarningReport,
+    warnings: Vec<Warning>,
+    origins: &[(&std::path::Path, usize)],
+) {
+    for w in warnings {
+        match w.layer.and_then(|l| origins.get(l)) {
+            Some(&(path, i)) => report.add(
+                Some(path),
+                [Warning {
+                    layer: Some(i),
+                    ..w
+                }],
+            ),
+            None => report.add(None, [w]),
+        }
     }
 }
 

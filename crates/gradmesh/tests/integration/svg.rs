@@ -307,7 +307,12 @@ fn all_thirteen_files_are_read_as_their_text_says() {
 #[test]
 fn content_left_out_is_named() {
     let scene = read(&FILES[9]);
-    let warnings = scene.warnings.join("\n");
+    let warnings = scene
+        .warnings
+        .iter()
+        .map(|w| w.message.as_str())
+        .collect::<Vec<_>>()
+        .join("\n");
     assert!(
         warnings.contains(r##"<ellipse id="ellipse5941"> at 254:3: fill "#80ffb3" left out"##),
         "{warnings}"

@@ -8,7 +8,7 @@ use kurbo::{Point, Vec2};
 
 use super::scene::{coons_interior, PdfPicture, ShadingFill};
 use crate::colour::ColourSpace;
-use crate::error::Warning;
+use crate::error::{Warning, WarningKind};
 use crate::mesh::{edge_key, ControlPoint, Document, GradientMesh};
 
 /// The document of every fill of `picture`, one layer per fill in paint order, with colours
@@ -17,17 +17,14 @@ pub fn picture_to_document(picture: &PdfPicture, space: ColourSpace) -> (Documen
     let mut warnings: Vec<Warning> = picture
         .warnings
         .iter()
-        .map(|message| Warning {
-            layer: None,
-            message: message.clone(),
-        })
+        .map(|message| Warning::new(WarningKind::PdfLeftOut, message.clone()))
         .collect();
     let mut doc = Document::default();
     for (layer, fill) in picture.fills.iter().enumerate() {
         let (mesh, notes) = fill_to_layer(fill, space);
         warnings.extend(notes.into_iter().map(|message| Warning {
             layer: Some(layer),
-            message,
+            ..Warning::new(WarningKind::PdfLeftOut, message)
         }));
         doc.layers.push(mesh);
     }

@@ -6,7 +6,7 @@ use std::str::FromStr;
 use kurbo::Affine;
 use roxmltree::Node;
 
-use crate::error::{Error, ErrorKind, Location};
+use crate::error::{Error, ErrorKind, Location, Warning, WarningKind};
 
 /// The SVG namespace.
 pub(super) const SVG_NS: &str = "http://www.w3.org/2000/svg";
@@ -46,20 +46,31 @@ pub(super) fn limit_at(node: Node, what: String, found: u64, limit: u64) -> Erro
     }
 }
 
-/// A warning about `node`, naming it and its line.
-pub(super) fn warning_at(node: Node, message: impl std::fmt::Display) -> String {
+/// A warning of `kind` about `node`, naming it and its line.
+pub(super) fn warning_at(
+    node: Node,
+    kind: WarningKind,
+    message: impl std::fmt::Display,
+) -> Warning {
     let (line, column) = line_column(node);
-    format!("{} at {line}:{column}: {message}", describe(node))
+    Warning::new(
+        kind,
+        format!("{} at {line}:{column}: {message}", describe(node)),
+    )
 }
 
 /// A warning that an invalid attribute of `node` is ignored, from the error reading it gave
 /// (which names the element, the attribute and the value).
-pub(super) fn ignored(node: Node, e: &Error) -> String {
+pub(super) fn ignored(node: Node, e: &Error) -> Warning {
     let text = e.kind.to_string();
     let (_, column) = line_column(node);
     let prefix = format!("{} at column {column}: ", describe(node));
     let message = text.strip_prefix(&prefix).unwrap_or(&text);
-    warning_at(node, format!("{message}: ignored"))
+    warning_at(
+        node,
+        WarningKind::SvgReadDifferently,
+        format!("{message}: ignored"),
+    )
 }
 
 /// Whether `node` is an SVG element (or an element in no namespace) named one of `names`.

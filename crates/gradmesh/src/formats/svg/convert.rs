@@ -7,26 +7,19 @@ use kurbo::CubicBez;
 
 use super::scene::{MeshFill, MeshGrid, SvgScene};
 use crate::colour::{parse_css_colour, ColourSpace};
-use crate::error::Warning;
+use crate::error::{Warning, WarningKind};
 use crate::mesh::{edge_key, ControlPoint, Document, GradientMesh};
 
 /// The document of every fill of `scene`, one layer per fill in paint order, with colours in
 /// `space`, and the warnings of the reading and of the conversion.
 pub fn scene_to_document(scene: &SvgScene, space: ColourSpace) -> (Document, Vec<Warning>) {
-    let mut warnings: Vec<Warning> = scene
-        .warnings
-        .iter()
-        .map(|message| Warning {
-            layer: None,
-            message: message.clone(),
-        })
-        .collect();
+    let mut warnings = scene.warnings.clone();
     let mut doc = Document::default();
     for (layer, fill) in scene.fills.iter().enumerate() {
         let (mesh, notes) = fill_to_layer(fill, space);
-        warnings.extend(notes.into_iter().map(|message| Warning {
+        warnings.extend(notes.into_iter().map(|w| Warning {
             layer: Some(layer),
-            message,
+            ..w
         }));
         doc.layers.push(mesh);
     }
@@ -40,7 +33,7 @@ pub fn scene_to_document(scene: &SvgScene, space: ColourSpace) -> (Document, Vec
 /// fewer than three corners is dropped, so that the layer has no zero-length edge. Where the
 /// mesh's outline turns, the point is a `corner`. A corner's opacity is its stop's opacity
 /// times the fill's `fill-opacity` and group opacity.
-pub fn fill_to_layer(fill: &MeshFill, space: ColourSpace) -> (GradientMesh, Vec<String>) {
+pub fn fill_to_layer(fill: &MeshFill, space: ColourSpace) -> (GradientMesh, Vec<Warning>) {
     let grid = &fill.mesh;
     let (rows, columns) = (grid.rows, grid.columns);
     let index = |i: usize, j: usize| i * (columns + 1) + j;
@@ -64,10 +57,10 @@ pub fn fill_to_layer(fill: &MeshFill, space: ColourSpace) -> (GradientMesh, Vec<
         } else if grid.corners[root].colour != corner.colour
             || grid.corners[root].opacity != corner.opacity
         {
-            notes.push(format!(
+            notes.push(Warning::new(WarningKind::SvgReadDifferently, format!(
                 "corner ({}, {}) meets corner ({}, {}) across a side of zero length but has another colour or opacity: the first is kept",
                 k / (columns + 1), k % (columns + 1), root / (columns + 1), root % (columns + 1)
-            ));
+            )));
         }
         point_of[k] = point_of[root];
     }
@@ -93,7 +86,7 @@ pub fn fill_to_layer(fill: &MeshFill, space: ColourSpace) -> (GradientMesh, Vec<
                 face.pop();
             }
             if face.len() < 3 {
-                notes.push(format!("the patch in row {r}, column {c} has no area (its sides have zero length): left out"));
+                notes.push(Warning::new(WarningKind::SvgMeshLeftOut, format!("the patch in row {r}, column {c} has no area (its sides have zero length): left out")));
                 continue;
             }
             for k in 0..face.len() {

@@ -8,7 +8,7 @@ use roxmltree::{Node, NodeId};
 
 use super::attr::{self, error_at, is_svg_element, limit_at, warning_at};
 use super::scene::{Corner, MeshGrid, MeshType};
-use crate::error::Error;
+use crate::error::{Error, Warning, WarningKind};
 
 /// Element names of a mesh gradient: SVG 2 draft, Inkscape 0.91, Inkscape 0.92 pre-releases.
 pub(super) const MESH_GRADIENT: [&str; 3] = ["meshgradient", "meshGradient", "mesh"];
@@ -54,7 +54,7 @@ pub(super) fn is_mesh_gradient(node: Node) -> bool {
 pub(super) fn resolve<'a, 'input>(
     node: Node<'a, 'input>,
     ids: &HashMap<&'a str, Node<'a, 'input>>,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Warning>,
 ) -> Result<MeshGradient<'a, 'input>, Error> {
     let mut chain = vec![node];
     let mut seen: Vec<NodeId> = vec![node.id()];
@@ -112,6 +112,7 @@ pub(super) fn resolve<'a, 'input>(
         Some((n, other)) => {
             warnings.push(warning_at(
                 n,
+                WarningKind::SvgReadDifferently,
                 format!("type {other:?} is not bilinear, coons or bicubic: read as bilinear"),
             ));
             MeshType::Bilinear
@@ -200,7 +201,7 @@ pub(super) fn read_grid(
     gradient: &MeshGradient,
     origin: Point,
     max_patches: u64,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Warning>,
 ) -> Result<MeshGrid, Error> {
     let (rows, columns) = grid_size(gradient.rows_from, max_patches)?;
     let mut builder = GridBuilder::new(rows, columns, origin);
@@ -252,7 +253,7 @@ impl GridBuilder {
         patch: Node,
         r: usize,
         c: usize,
-        warnings: &mut Vec<String>,
+        warnings: &mut Vec<Warning>,
     ) -> Result<(), Error> {
         let sides = sides_of(r, c);
         let mut stops = patch.children().filter(|n| is_svg_element(*n, &["stop"]));
@@ -286,6 +287,7 @@ impl GridBuilder {
         if let Some(extra) = stops.next() {
             warnings.push(warning_at(
                 extra,
+                WarningKind::SvgReadDifferently,
                 format!(
                     "the patch in row {r}, column {c} needs {} stops: the rest are ignored",
                     sides.len()

@@ -10,7 +10,7 @@ use super::attr::{self, error_at, is_svg_element, warning_at};
 use super::gradient::{self, Units};
 use super::scene::{AspectRatio, FillRule, MeshFill, MeshGrid, SvgScene};
 use super::shape;
-use crate::error::{Error, ErrorKind, Location};
+use crate::error::{Error, ErrorKind, Location, Warning, WarningKind};
 use crate::formats::check_size;
 use crate::size_limits::Limits;
 
@@ -94,7 +94,7 @@ struct Reader<'a, 'input> {
     patches_so_far: u64,
     corners_so_far: u64,
     fills: Vec<MeshFill>,
-    warnings: Vec<String>,
+    warnings: Vec<Warning>,
 }
 
 impl<'a, 'input> Reader<'a, 'input> {
@@ -132,6 +132,7 @@ impl<'a, 'input> Reader<'a, 'input> {
                 _ => {
                     self.warnings.push(warning_at(
                         root,
+                        WarningKind::SvgReadDifferently,
                         format!("viewBox {text:?} is not a valid view box: ignored"),
                     ));
                     None
@@ -145,6 +146,7 @@ impl<'a, 'input> Reader<'a, 'input> {
                 Err(e) => {
                     self.warnings.push(warning_at(
                         root,
+                        WarningKind::SvgReadDifferently,
                         format!("preserveAspectRatio {text:?} is not valid ({e}): ignored"),
                     ));
                     AspectRatio::default()
@@ -220,6 +222,7 @@ impl<'a, 'input> Reader<'a, 'input> {
                 "line" => self.warn_paint(child, "stroke"),
                 _ => self.warnings.push(warning_at(
                     child,
+                    WarningKind::SvgNotMeshFill,
                     "left out: only shapes filled with mesh gradients are read",
                 )),
             }
@@ -236,6 +239,7 @@ impl<'a, 'input> Reader<'a, 'input> {
                 let value = value.unwrap_or("black");
                 self.warnings.push(warning_at(
                     node,
+                    WarningKind::SvgNotMeshFill,
                     format!("{property} {value:?} left out: only mesh-gradient fills are read"),
                 ));
             }
@@ -275,6 +279,7 @@ impl<'a, 'input> Reader<'a, 'input> {
                     .unwrap_or_default();
                 self.warnings.push(warning_at(
                     node,
+                    WarningKind::SvgMeshLeftOut,
                     format!("its mesh-gradient fill is left out: {line}{}", e.kind),
                 ));
                 return Ok(());
@@ -325,6 +330,7 @@ impl<'a, 'input> Reader<'a, 'input> {
                 if bbox.width() <= 0.0 || bbox.height() <= 0.0 {
                     self.warnings.push(warning_at(
                         shape,
+                        WarningKind::SvgMeshLeftOut,
                         "its bounding box is flat, so its objectBoundingBox mesh is not drawn",
                     ));
                     return Ok(None);

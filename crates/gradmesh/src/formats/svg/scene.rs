@@ -2,6 +2,8 @@
 
 use kurbo::{BezPath, CubicBez, Point, Rect};
 
+use crate::error::Warning;
+
 /// What an SVG document holds that gradmesh draws: every shape filled with a mesh gradient, in
 /// paint order, with everything resolved.
 ///
@@ -28,7 +30,7 @@ pub struct SvgScene {
     pub fills: Vec<MeshFill>,
     /// What was read but is not in `fills`, naming the element: content with other paints,
     /// strokes, text, images, and values replaced by defaults.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<Warning>,
 }
 
 /// CSS's size of a replaced element that gives none, in pixels.

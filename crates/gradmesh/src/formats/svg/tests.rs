@@ -35,7 +35,7 @@ fn error(body: &str) -> String {
 fn left_out(body: &str) -> String {
     let scene = read(body);
     assert!(scene.fills.is_empty(), "{body}");
-    scene.warnings.join("\n")
+    warning_text(&scene.warnings)
 }
 
 fn close(a: Point, b: Point) -> bool {
@@ -275,7 +275,7 @@ fn other_content_is_named_in_warnings() {
         square_gradient("m", 0.0, 0.0, 10.0, "")
     ));
     assert_eq!(scene.fills.len(), 1);
-    let all = scene.warnings.join("\n");
+    let all = warning_text(&scene.warnings);
     assert!(
         all.contains(r#"<rect id="flat"> at 4:46"#) && all.contains("fill \"#f00\" left out"),
         "{all}"
@@ -607,7 +607,7 @@ fn invalid_attributes_are_ignored_with_a_warning() {
         scene.fills[0].clip.bounding_box(),
         Rect::new(0.0, 0.0, 5.0, 5.0)
     );
-    let all = scene.warnings.join("\n");
+    let all = warning_text(&scene.warnings);
     for expected in [
         r#"<rect> at 5:1: opacity "1x" is not a number"#,
         r#"<rect> at 6:1: transform "qwe" is not a transform list"#,
@@ -624,7 +624,9 @@ fn invalid_attributes_are_ignored_with_a_warning() {
     let scene = read_svg(&text).unwrap();
     assert_eq!(scene.pixel_size(), (40.0, 20.0));
     assert!(
-        scene.warnings[0].contains(r#"width "wide" is not a length"#),
+        scene.warnings[0]
+            .message
+            .contains(r#"width "wide" is not a length"#),
         "{:?}",
         scene.warnings
     );
@@ -715,4 +717,10 @@ fn a_missing_or_zero_size_is_the_css_default_or_the_view_box() {
         size(r#"height="0" viewBox="0 0 40 20""#),
         ((40.0, 20.0), r(0.0, 0.0, 40.0, 20.0))
     );
+}
+
+/// The messages of `warnings`, a line each.
+fn warning_text(warnings: &[crate::Warning]) -> String {
+    let lines: Vec<&str> = warnings.iter().map(|w| w.message.as_str()).collect();
+    lines.join("\n")
 }
