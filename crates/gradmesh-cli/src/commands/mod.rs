@@ -9,6 +9,7 @@ mod resvg_guard;
 mod serve;
 mod vectorise;
 mod warnings;
+#[cfg(feature = "svg-whole-picture")]
 mod whole_picture;
 
 use std::path::Path;

@@ -12,7 +12,6 @@ use gradmesh::{ColourSpace, Document, Error, ErrorKind, Warning, WarningKind};
 
 use crate::args::RenderArgs;
 
-use super::whole_picture;
 use super::WarningReport;
 
 fn invalid(what: &str, message: String) -> Error {
@@ -171,10 +170,8 @@ pub fn run(args: &RenderArgs, report: &mut WarningReport) -> Result<(), Error> {
             let path = &args.inputs[0];
             let text = std::fs::read_to_string(path)
                 .map_err(|e| Error::new(ErrorKind::Io(format!("{}: {e}", path.display()))))?;
-            let max_memory = args.max_memory.unwrap_or_else(machine_memory);
-            let drawn =
-                whole_picture::render_whole_picture((path, &text), layers, &opts, max_memory)
-                    .map_err(|e| locate(e).in_file(path))?;
+            let drawn = whole_svg_picture((path, &text), layers, &opts, args.max_memory)
+                .map_err(|e| locate(e).in_file(path))?;
             report.add(Some(path), left_out_of(&mut left_out[0].1, drawn.is_ok()));
             if let Err(message) = &drawn {
                 eprintln!(
@@ -303,6 +300,35 @@ fn left_out_of(warnings: &mut Vec<Warning>, drawn: bool) -> Vec<Warning> {
     warnings
 }
 
+/// The picture that the whole SVG `text` draws, its mesh fills being `layers`: see
+/// `whole_picture`, within `max_memory` bytes (default: the machine's memory).
+/// `Ok(Err(message))` says why only the mesh fills are drawn.
+#[cfg(feature = "svg-whole-picture")]
+fn whole_svg_picture(
+    file: (&std::path::Path, &str),
+    layers: &[PictureLayer<'_>],
+    opts: &RenderOptions,
+    max_memory: Option<u64>,
+) -> Result<Result<(render::Image, render::RenderInfo), String>, Error> {
+    let max_memory = max_memory.unwrap_or_else(machine_memory);
+    super::whole_picture::render_whole_picture(file, layers, opts, max_memory)
+}
+
+/// Without resvg, only the mesh fills of an SVG file are drawn.
+#[cfg(not(feature = "svg-whole-picture"))]
+fn whole_svg_picture(
+    _file: (&std::path::Path, &str),
+    _layers: &[PictureLayer<'_>],
+    _opts: &RenderOptions,
+    _max_memory: Option<u64>,
+) -> Result<Result<(render::Image, render::RenderInfo), String>, Error> {
+    Ok(Err(
+        "this gradmesh was built without resvg, which draws the rest (cargo feature \
+         `svg-whole-picture`, on by default)"
+            .into(),
+    ))
+}
+
 /// Draws `picture` when there is one, else `doc`, into `out`.
 fn draw<P: render::OutputPixel>(
     doc: &Document,
@@ -426,6 +452,7 @@ fn add_warnings(
 
 /// The machine's memory in bytes (MemTotal in /proc/meminfo), or no limit where it is not
 /// known.
+#[cfg(feature = "svg-whole-picture")]
 fn machine_memory() -> u64 {
     std::fs::read_to_string("/proc/meminfo")
         .ok()
