@@ -2,7 +2,7 @@
 //! (WebDriver). Loads a document, drags a point with mouse events, changes a colour, toggles a
 //! crease, makes a multi-resolution colour edit, undoes, saves, and compares the canvas with
 //! gradmesh's own render of the saved file. Fails (never skips) when Chromium or chromedriver
-//! is missing: `.ci/run` installs them.
+//! is missing: `scripts/test.sh` installs them.
 //!
 //! Screenshots go to `target/editor-screenshots/`; with `GRADMESH_UPDATE_SCREENSHOTS=1` they
 //! are also copied to `docs/editor.png` and `docs/editor-edited.png`.
