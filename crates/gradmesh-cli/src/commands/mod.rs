@@ -5,6 +5,7 @@ mod edits;
 mod info;
 mod refine;
 mod render;
+#[cfg(feature = "svg-whole-picture")]
 mod resvg_guard;
 mod serve;
 mod vectorise;
