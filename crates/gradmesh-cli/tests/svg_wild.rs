@@ -263,7 +263,8 @@ fn a_zero_size_is_the_css_default() {
 }
 
 /// An invalid attribute on another element is ignored with a warning naming the element, the
-/// attribute and the line; the rest of the picture is drawn.
+/// attribute and the line (counted in one line by default, listed with `--warnings`); the rest
+/// of the picture is drawn.
 #[test]
 fn invalid_attributes_are_ignored_with_a_warning() {
     for (name, attribute) in [
@@ -273,7 +274,14 @@ fn invalid_attributes_are_ignored_with_a_warning() {
             "transform \"qwe\"",
         ),
     ] {
-        let (out, dir) = render(name, &[]);
+        let (quiet, _) = render(name, &[]);
+        let summary = stderr(&quiet);
+        assert!(
+            summary.contains("1 SVG attribute ignored or read differently: --warnings to list")
+                && summary.lines().count() == 1,
+            "{name}: {summary}"
+        );
+        let (out, dir) = render(name, &["--warnings"]);
         let message = stderr(&out);
         assert!(out.status.success(), "{name}: {message}");
         assert!(
