@@ -56,6 +56,7 @@ mod size_limits;
 mod ternary_step;
 mod topology;
 mod validate;
+mod view;
 
 pub use colour::{parse_css_colour, ColourSpace};
 pub use edit_check::EditSet;

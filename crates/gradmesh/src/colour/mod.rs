@@ -1,6 +1,7 @@
 //! Working colour spaces, conversion to and from sRGB, and CSS colour strings.
 
 pub(crate) mod fast;
+pub(crate) mod gamut;
 
 use palette::convert::FromColorUnclamped;
 use palette::{white_point::D65, Lab, LinSrgb, Oklab};

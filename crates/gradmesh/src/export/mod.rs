@@ -12,8 +12,7 @@
 //! soft mask.
 //!
 //! ```
-//! use gradmesh::export::{write_pdf, ExportOptions};
-//! use gradmesh::render::View;
+//! use gradmesh::export::{write_pdf, ExportOptions, View};
 //! use gradmesh::{ColourSpace, Document, GradientMesh};
 //! use kurbo::Point;
 //!
@@ -42,13 +41,13 @@ use rayon::prelude::*;
 
 use crate::error::{Error, ErrorKind, Warning};
 use crate::mesh::Document;
-use crate::render::view::ToPixels;
-use crate::render::{RenderOptions, View};
 use crate::size_limits::Limits;
+use crate::view::{check_image, ToPixels, MAX_PIXELS};
 
 use split::{OutPatch, Splitter, Target};
 use surface::{layer_surface, Curve, SurfaceOptions};
 
+pub use crate::view::View;
 pub use pdf::{write_pdf, POINTS_PER_PIXEL};
 pub use svg::write_svg;
 
@@ -131,11 +130,12 @@ impl ExportOptions {
             .unwrap_or((f64::from(self.width), f64::from(self.height)))
     }
 
-    /// Refuses a page or view that [`RenderOptions::check`] refuses for an image of the same
-    /// size, a page size that is not positive and finite, and tolerances that are not
-    /// positive and finite.
+    /// Refuses a page or view that
+    /// [`RenderOptions::check`](crate::render::RenderOptions::check) refuses for an image of
+    /// the same size (at most [`MAX_PIXELS`] pixels), a page size that is not positive and
+    /// finite, and tolerances that are not positive and finite.
     pub fn check(&self) -> Result<(), Error> {
-        RenderOptions::new(self.width, self.height, self.view).check()?;
+        check_image(self.width, self.height, &self.view, MAX_PIXELS)?;
         let (pw, ph) = self.page_size_px();
         if !(pw.is_finite() && ph.is_finite() && pw > 0.0 && ph > 0.0) {
             return Err(ErrorKind::Invalid {

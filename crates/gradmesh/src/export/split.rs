@@ -16,8 +16,8 @@ use palette::color_difference::Ciede2000;
 use palette::{white_point::D65, Lab};
 
 use super::bezier::{evaluate, sub_net, BezierNet};
+use crate::colour::gamut::{to_blend_space, BlendSpace, GamutMapping};
 use crate::colour::ColourSpace;
-use crate::render::gamut::{to_blend_space, BlendSpace, GamutMapping};
 use crate::validate::VertexData;
 
 /// The bound's usual overestimate: counts start from the bound at this many times the tolerance.

@@ -14,13 +14,13 @@ use std::collections::HashMap;
 use crate::colour::ColourSpace;
 use crate::error::{Error, ErrorKind, Warning};
 use crate::level::Level;
+use crate::limit_surface::boundary::{boundary_loops, for_each_boundary_segment};
 use crate::limit_surface::patches::{regular_corners, regular_patch_with, LocalPatch, ShapeCache};
 use crate::mesh::GradientMesh;
 use crate::refine::Refinement;
-use crate::render::outline::{boundary_loops, for_each_boundary_segment};
-use crate::render::view::ToPixels;
 use crate::size_limits::Limits;
 use crate::validate::VertexData;
+use crate::view::ToPixels;
 
 use super::bezier::{bilinear_net, bspline_to_bezier, BezierNet};
 use super::split::delta_e00;

@@ -13,6 +13,7 @@
 //!
 //! As in OpenSubdiv, a semi-sharp feature still present at the level counts as sharp.
 
+pub(crate) mod boundary;
 pub(crate) mod patches;
 
 use std::collections::HashMap;

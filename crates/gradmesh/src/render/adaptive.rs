@@ -37,8 +37,8 @@ use super::measure::{Measure, Thresholds};
 use super::nearest::Segment;
 use super::stitch::{colour_bounds, Stitching};
 use super::triangles::{Bounds, Triangle, TriangleList};
-use super::view::ToPixels;
 use crate::limit_surface::patches::ShapeCache;
+use crate::view::ToPixels;
 
 /// The level whose faces get their own density: all quads, extraordinary vertices isolated,
 /// and faces small enough that irregular ones (refined locally) cover little of the layer.

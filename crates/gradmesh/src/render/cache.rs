@@ -6,9 +6,9 @@ use std::sync::Arc;
 use crate::mesh::GradientMesh;
 
 use super::adaptive;
-use super::gamut::{BlendSpace, GamutMapping};
 use super::layer;
 use super::options::RenderOptions;
+use crate::colour::gamut::{BlendSpace, GamutMapping};
 use crate::limit_surface::patches::ShapeCache;
 
 /// Layers prepared for drawing (refined, tessellated and binned), kept between renders of a

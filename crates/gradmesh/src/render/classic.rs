@@ -30,11 +30,11 @@ use super::clip::clip_lines;
 use super::layer::{bin_triangles, visible_outline, DrawableLayer, LayerPreparation, BAND};
 use super::nearest::{NearestSegments, Segment};
 use super::triangles::{screen_triangle_px, Triangle, TriangleList, UNBOUNDED};
-use super::view::ToPixels;
 use super::{LayerInfo, LayerTimings, RenderOptions};
 use crate::colour::ColourSpace;
 use crate::error::{Error, ErrorKind};
 use crate::formats::svg::{MeshFill, MeshGrid, MeshType};
+use crate::view::ToPixels;
 
 /// The widest a cell may be (pixels, along each parameter): colour is bilinear in the patch's
 /// parameters, and a cell's two triangles interpolate it linearly in the plane; over a cell of

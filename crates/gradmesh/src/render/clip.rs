@@ -10,7 +10,7 @@
 use kurbo::{Affine, BezPath, PathEl, Point};
 
 use super::coverage::Line;
-use super::view::ToPixels;
+use crate::view::ToPixels;
 
 /// Flattening tolerance of a clip outline (pixels), as for a layer's own outline.
 const CLIP_TOLERANCE_PX: f64 = 0.002;

@@ -9,13 +9,13 @@ use crate::colour::ColourSpace;
 
 use super::coverage;
 use super::each4;
-use super::gamut::GamutMapping;
-use super::gamut::{self, BlendSpace, RUN};
 use super::layer::{Clip, DrawableLayer, BAND};
 use super::options::RenderOptions;
 use super::output;
 use super::output::OutputPixel;
 use super::triangles;
+use crate::colour::gamut::GamutMapping;
+use crate::colour::gamut::{self, BlendSpace, RUN};
 
 /// Per-thread working buffers, fully reset by each band that uses them.
 pub(super) struct Scratch {

@@ -14,10 +14,10 @@ use crate::validate::VertexData;
 use super::each4;
 use super::measure::{measure_quad, Measure, QuadSamples, Thresholds};
 use super::quadratic::{measure_cells, Cell};
-use super::view::ToPixels;
 use crate::limit_surface::patches::{
     regular_corners, regular_patch_with, ControlGrid, Grid, LocalPatch, ShapeCache,
 };
+use crate::view::ToPixels;
 
 /// Quadratic colour is tried on a face only while its linear error is at most this many times
 /// the tolerance: with larger errors the quarter points that check it can miss a steep colour

@@ -20,11 +20,12 @@ use super::clip::clip_lines;
 use super::coverage::Line;
 use super::measure::{measure, Measure, Thresholds, MIN_QUAD_PX};
 use super::nearest::{NearestSegments, Segment};
-use super::outline::{boundary_loops, outline};
+use super::outline::outline;
 use super::triangles::{screen_triangle_px, snap, Bounds, Triangle, TriangleList, UNBOUNDED};
-use super::view::ToPixels;
 use super::{LayerInfo, LayerTimings, RenderOptions};
+use crate::limit_surface::boundary::boundary_loops;
 use crate::limit_surface::patches::ShapeCache;
+use crate::view::ToPixels;
 
 /// Rows per band: the unit of parallel work.
 pub(crate) const BAND: usize = 16;

@@ -9,8 +9,8 @@ use crate::colour::{ColourSpace, Matrix3};
 use crate::topology::Topology;
 use crate::validate::VertexData;
 
-use super::view::ToPixels;
 use super::{each3, each4, RenderOptions};
+use crate::view::ToPixels;
 
 /// Colour errors count in quads at least this wide (diagonal, pixels) in the fast path...
 pub(super) const MIN_QUAD_PX: f64 = 1.0;

@@ -3,21 +3,9 @@
 use crate::error::{Error, ErrorKind};
 use crate::mesh::Document;
 
-use super::gamut::{BlendSpace, GamutMapping};
-use super::view::View;
+use crate::colour::gamut::{BlendSpace, GamutMapping};
 use crate::colour::ColourSpace;
-
-/// The largest image side accepted.
-pub const MAX_SIDE: u32 = 1 << 15;
-/// The default largest pixel count ([`RenderOptions::max_pixels`]): 100 megapixels.
-pub const MAX_PIXELS: u64 = 100_000_000;
-/// The largest magnitude of a view's coordinates (1e150): that of a mesh's.
-pub const MAX_VIEW_MAGNITUDE: f64 = crate::validate::MAX_MAGNITUDE;
-/// The smallest pixel, in plane units (1e-150): a mesh's shortest edge.
-pub const MIN_PIXEL_SIZE: f64 = crate::validate::MIN_EDGE_LENGTH;
-/// The smallest pixel relative to the view's largest coordinate (2^-32): smaller pixels leave
-/// too few bits of a coordinate to place anti-aliased edges within them.
-pub const MIN_RELATIVE_PIXEL_SIZE: f64 = 1.0 / 4_294_967_296.0;
+use crate::view::{check_image, View, MAX_PIXELS};
 
 /// How to render a document.
 #[derive(Clone, Debug, PartialEq)]
@@ -119,12 +107,15 @@ impl RenderOptions {
         RenderOptions::new(width, height, View::new(cx - hw, cy - hh, cx + hw, cy + hh))
     }
 
-    /// Refuses options that cannot be rendered: an empty image, a side above [`MAX_SIDE`], more
-    /// pixels than [`RenderOptions::max_pixels`], a view that is empty, not finite, beyond
-    /// ±[`MAX_VIEW_MAGNITUDE`] or whose pixels are smaller than its coordinates can resolve
-    /// ([`MIN_PIXEL_SIZE`], [`MIN_RELATIVE_PIXEL_SIZE`]), and tolerances or a background that
-    /// are not finite. (A forced [`RenderOptions::level`] is checked against
-    /// [`RenderOptions::max_quads`](super::RenderOptions::max_quads) for each layer, from its base mesh, before it is built.)
+    /// Refuses options that cannot be rendered: an empty image, a side above
+    /// [`MAX_SIDE`](super::MAX_SIDE), more pixels than [`RenderOptions::max_pixels`], a view
+    /// that is empty, not finite, beyond ±[`MAX_VIEW_MAGNITUDE`](super::MAX_VIEW_MAGNITUDE) or
+    /// whose pixels are smaller than its coordinates can resolve
+    /// ([`MIN_PIXEL_SIZE`](super::MIN_PIXEL_SIZE),
+    /// [`MIN_RELATIVE_PIXEL_SIZE`](super::MIN_RELATIVE_PIXEL_SIZE)), and tolerances or a
+    /// background that are not finite. (A forced
+    /// [`RenderOptions::level`] is checked against [`RenderOptions::max_quads`] for each layer,
+    /// from its base mesh, before it is built.)
     ///
     /// Every render function calls it first, before allocating anything; a caller that
     /// allocates its own output buffer for [`render_document_into`](super::render_document_into) calls it before that.
@@ -136,31 +127,7 @@ impl RenderOptions {
             }
             .into()
         };
-        if self.width == 0 || self.height == 0 {
-            return Err(invalid(
-                "image size",
-                format!("{}x{} has no pixels", self.width, self.height),
-            ));
-        }
-        let pixels = self.width as u64 * self.height as u64;
-        if pixels > self.max_pixels {
-            return Err(ErrorKind::LimitExceeded {
-                what: "pixel count".into(),
-                found: pixels,
-                limit: self.max_pixels,
-            }
-            .into());
-        }
-        let side = self.width.max(self.height);
-        if side > MAX_SIDE {
-            return Err(ErrorKind::LimitExceeded {
-                what: "image side".into(),
-                found: side as u64,
-                limit: MAX_SIDE as u64,
-            }
-            .into());
-        }
-        self.check_view()?;
+        check_image(self.width, self.height, &self.view, self.max_pixels)?;
         for (name, value) in [
             ("tolerance", self.tolerance_px),
             ("colour tolerance", self.colour_tolerance),
@@ -174,43 +141,6 @@ impl RenderOptions {
             if bg.iter().any(|c| !c.is_finite()) {
                 return Err(invalid("background", format!("{bg:?} is not finite")));
             }
-        }
-        Ok(())
-    }
-
-    /// Refuses a view that is empty or not finite, reaches beyond ±[`MAX_VIEW_MAGNITUDE`], or
-    /// whose pixels are smaller than [`MIN_PIXEL_SIZE`] or than [`MIN_RELATIVE_PIXEL_SIZE`]
-    /// times its largest coordinate (adjacent pixels would map to the same plane coordinates).
-    fn check_view(&self) -> Result<(), Error> {
-        let v = &self.view;
-        let corners = [v.x0, v.y0, v.x1, v.y1];
-        let shown = format!("({:?}, {:?}) to ({:?}, {:?})", v.x0, v.y0, v.x1, v.y1);
-        let invalid = |message: String| -> Error {
-            ErrorKind::Invalid {
-                what: "view".into(),
-                message: format!("{shown}: {message}"),
-            }
-            .into()
-        };
-        if !corners.iter().all(|x| x.is_finite()) {
-            return Err(invalid("every coordinate must be a finite number".into()));
-        }
-        let largest = corners.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        if largest > MAX_VIEW_MAGNITUDE {
-            return Err(invalid(format!(
-                "a coordinate is beyond ±{MAX_VIEW_MAGNITUDE:e}, the largest a mesh may have"
-            )));
-        }
-        if !(v.width() > 0.0 && v.height() > 0.0) {
-            return Err(invalid("x1 must exceed x0 and y1 must exceed y0".into()));
-        }
-        let pixel = (v.width() / self.width as f64).min(v.height() / self.height as f64);
-        let smallest = MIN_PIXEL_SIZE.max(MIN_RELATIVE_PIXEL_SIZE * largest);
-        if pixel < smallest {
-            return Err(invalid(format!(
-                "a pixel would be {pixel:e} units across, below the {smallest:e} that \
-                 coordinates of this size resolve"
-            )));
         }
         Ok(())
     }

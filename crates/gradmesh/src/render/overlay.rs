@@ -5,10 +5,11 @@ use crate::mesh::Document;
 use crate::refine::Refinement;
 
 use super::coverage::{Accumulator, Line};
-use super::outline::{boundary_loops, outline};
+use super::outline::outline;
 use super::output::Image;
-use super::view::ToPixels;
 use super::RenderOptions;
+use crate::limit_surface::boundary::boundary_loops;
+use crate::view::ToPixels;
 
 /// The colour of the outline: near-black, opaque (sRGB).
 const OUTLINE_COLOUR: [f32; 3] = [0.08, 0.08, 0.08];

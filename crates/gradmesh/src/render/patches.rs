@@ -28,11 +28,11 @@ use super::coverage::Line;
 use super::layer::{bin_triangles, visible_outline, DrawableLayer, LayerPreparation, BAND};
 use super::nearest::{NearestSegments, Segment};
 use super::triangles::{screen_triangle_px, Triangle, TriangleList, UNBOUNDED};
-use super::view::ToPixels;
 use super::{LayerInfo, LayerTimings, RenderOptions};
 use crate::colour::ColourSpace;
 use crate::error::{Error, ErrorKind};
 use crate::formats::pdf::{Patch, ShadingFill};
+use crate::view::ToPixels;
 
 /// The widest a cell may be (pixels, along each parameter).
 const CELL_PX: f64 = 4.0;

@@ -20,8 +20,8 @@ use crate::validate::VertexData;
 
 use super::each4;
 use super::measure::sample_error;
-use super::view::ToPixels;
 use crate::colour::{ColourSpace, Matrix3};
+use crate::view::ToPixels;
 
 /// The screen gradient of the four attributes: `grad[k] = [d/dx, d/dy]`.
 pub(super) type Gradient = [[f64; 2]; 4];

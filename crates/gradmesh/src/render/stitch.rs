@@ -14,9 +14,9 @@ use super::face_plans::{each_face, edge_counts, CellOrders, FacePlanner, FacePla
 use super::nearest::Segment;
 use super::quadratic::{chord_node, screen_gradient, Cell, Quadratic};
 use super::triangles::{snap, Bounds, Triangle, UNBOUNDED};
-use super::view::ToPixels;
 use super::{each3, each4};
 use crate::limit_surface::patches::Grid;
+use crate::view::ToPixels;
 
 /// The grid position of parameter `s` (`0..=m`) along side `k` of a face, from its corner `k`
 /// to its corner `k + 1`.
@@ -291,7 +291,7 @@ impl<'a> Stitching<'a> {
     pub fn boundary_segments(&self) -> Vec<Segment> {
         let t = self.t;
         let mut segments = Vec::new();
-        for lp in super::outline::boundary_loops(t) {
+        for lp in crate::limit_surface::boundary::boundary_loops(t) {
             for i in 0..lp.len() {
                 let (a, b) = (lp[i], lp[(i + 1) % lp.len()]);
                 let Some(&e) = t.vertex_edges(a as usize).iter().find(|&&e| {

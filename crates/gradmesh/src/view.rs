@@ -1,8 +1,24 @@
-//! The rectangle of the plane shown in an image, and the map from the plane to pixels.
+//! The rectangle of the plane shown in a picture, the limits on a picture's size and view, and
+//! the map from the plane to pixels: what the renderer and the vector export both place their
+//! output with.
 
 use kurbo::{Point, Rect};
 
+use crate::error::{Error, ErrorKind};
 use crate::mesh::Document;
+
+/// The largest image side accepted.
+pub const MAX_SIDE: u32 = 1 << 15;
+/// The default largest pixel count
+/// ([`RenderOptions::max_pixels`](crate::render::RenderOptions::max_pixels)): 100 megapixels.
+pub const MAX_PIXELS: u64 = 100_000_000;
+/// The largest magnitude of a view's coordinates (1e150): that of a mesh's.
+pub const MAX_VIEW_MAGNITUDE: f64 = crate::validate::MAX_MAGNITUDE;
+/// The smallest pixel, in plane units (1e-150): a mesh's shortest edge.
+pub const MIN_PIXEL_SIZE: f64 = crate::validate::MIN_EDGE_LENGTH;
+/// The smallest pixel relative to the view's largest coordinate (2^-32): smaller pixels leave
+/// too few bits of a coordinate to place anti-aliased edges within them.
+pub const MIN_RELATIVE_PIXEL_SIZE: f64 = 1.0 / 4_294_967_296.0;
 
 /// The rectangle of the plane shown: `(x0, y0)` is the top-left corner, `(x1, y1)` the
 /// bottom-right one. y grows downward, as in SVG.
@@ -139,4 +155,79 @@ impl ToPixels {
     pub fn apply(&self, x: f64, y: f64) -> [f64; 2] {
         [(x - self.x0) * self.sx, (y - self.y0) * self.sy]
     }
+}
+
+/// Refuses a `width` x `height` picture of `view`: one without pixels, with more than
+/// `max_pixels` pixels or a side above [`MAX_SIDE`], or whose view is empty, not finite, beyond
+/// ±[`MAX_VIEW_MAGNITUDE`] or has pixels smaller than [`MIN_PIXEL_SIZE`] or than
+/// [`MIN_RELATIVE_PIXEL_SIZE`] times its largest coordinate (adjacent pixels would map to the
+/// same plane coordinates).
+pub(crate) fn check_image(
+    width: u32,
+    height: u32,
+    view: &View,
+    max_pixels: u64,
+) -> Result<(), Error> {
+    if width == 0 || height == 0 {
+        return Err(ErrorKind::Invalid {
+            what: "image size".into(),
+            message: format!("{width}x{height} has no pixels"),
+        }
+        .into());
+    }
+    let pixels = width as u64 * height as u64;
+    if pixels > max_pixels {
+        return Err(ErrorKind::LimitExceeded {
+            what: "pixel count".into(),
+            found: pixels,
+            limit: max_pixels,
+        }
+        .into());
+    }
+    let side = width.max(height);
+    if side > MAX_SIDE {
+        return Err(ErrorKind::LimitExceeded {
+            what: "image side".into(),
+            found: side as u64,
+            limit: MAX_SIDE as u64,
+        }
+        .into());
+    }
+    check_view(view, width, height)
+}
+
+/// Refuses a view that is empty or not finite, reaches beyond ±[`MAX_VIEW_MAGNITUDE`], or
+/// whose pixels (at `width` x `height`) are smaller than [`MIN_PIXEL_SIZE`] or than
+/// [`MIN_RELATIVE_PIXEL_SIZE`] times its largest coordinate.
+fn check_view(v: &View, width: u32, height: u32) -> Result<(), Error> {
+    let corners = [v.x0, v.y0, v.x1, v.y1];
+    let shown = format!("({:?}, {:?}) to ({:?}, {:?})", v.x0, v.y0, v.x1, v.y1);
+    let invalid = |message: String| -> Error {
+        ErrorKind::Invalid {
+            what: "view".into(),
+            message: format!("{shown}: {message}"),
+        }
+        .into()
+    };
+    if !corners.iter().all(|x| x.is_finite()) {
+        return Err(invalid("every coordinate must be a finite number".into()));
+    }
+    let largest = corners.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if largest > MAX_VIEW_MAGNITUDE {
+        return Err(invalid(format!(
+            "a coordinate is beyond ±{MAX_VIEW_MAGNITUDE:e}, the largest a mesh may have"
+        )));
+    }
+    if !(v.width() > 0.0 && v.height() > 0.0) {
+        return Err(invalid("x1 must exceed x0 and y1 must exceed y0".into()));
+    }
+    let pixel = (v.width() / width as f64).min(v.height() / height as f64);
+    let smallest = MIN_PIXEL_SIZE.max(MIN_RELATIVE_PIXEL_SIZE * largest);
+    if pixel < smallest {
+        return Err(invalid(format!(
+            "a pixel would be {pixel:e} units across, below the {smallest:e} that \
+             coordinates of this size resolve"
+        )));
+    }
+    Ok(())
 }

@@ -1,12 +1,12 @@
 //! From a working-space colour to a displayable sRGB colour: conversion to linear light, gamut
 //! mapping, and the choice of compositing space.
 
-use crate::colour::fast::{
+use super::fast::{
     encode_table_f32, lab_matrix_f32, lab_to_linear_srgb, lab_to_linear_srgb_f32,
     linear_srgb_to_oklab_lanes, oklab_to_linear_srgb_lanes, srgb_encode_f32_with, srgb_encode_fast,
     srgb_encode_unit_f32, ENCODE_TABLE_F32_LEN,
 };
-use crate::colour::ColourSpace;
+use super::ColourSpace;
 
 /// What to do with a colour that lies outside the sRGB gamut.
 ///
@@ -51,21 +51,6 @@ impl GamutMapping {
             GamutMapping::Clip => clip(rgb),
             GamutMapping::Chroma => reduce_chroma(rgb),
         }
-    }
-
-    /// [`GamutMapping::apply`] to every colour of `colours`, in place: the same bits as one
-    /// by one, in less time where many colours lie outside the gamut (the chroma search then
-    /// runs on sixteen colours at once).
-    ///
-    /// ```
-    /// use gradmesh::render::GamutMapping;
-    /// let mut colours = [[1.2, 0.5, -0.1], [0.2, 0.4, 0.6]];
-    /// let one_by_one = colours.map(|c| GamutMapping::Chroma.apply(c));
-    /// GamutMapping::Chroma.apply_to_all(&mut colours);
-    /// assert_eq!(colours, one_by_one);
-    /// ```
-    pub fn apply_to_all(self, colours: &mut [[f64; 3]]) {
-        super::map_gamut_dispatched(self, colours)
     }
 
     /// [`GamutMapping::apply_to_all`], inlined into each compilation of it.
@@ -704,7 +689,7 @@ mod tests {
     /// space, for colours inside and outside the gamut, and for partial runs.
     #[test]
     fn run_conversion_matches_single_colours() {
-        let mut bits = super::super::test_random(0x853c_49e6_748f_ea9b_u64);
+        let mut bits = crate::render::test_random(0x853c_49e6_748f_ea9b_u64);
         let mut next = || (bits() >> 11) as f32 / (1u64 << 53) as f32;
         let spaces = [
             ColourSpace::Lab,
@@ -844,7 +829,7 @@ mod tests {
     /// groups they wait in.
     #[test]
     fn waiting_colours_match_single_colours() {
-        let mut bits = super::super::test_random(0x2545_f491_4f6c_dd1d_u64);
+        let mut bits = crate::render::test_random(0x2545_f491_4f6c_dd1d_u64);
         let mut next = || (bits() >> 11) as f32 / (1u64 << 53) as f32;
         for space in [
             ColourSpace::Srgb,
