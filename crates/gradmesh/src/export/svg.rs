@@ -6,20 +6,39 @@
 //! Bézier boundary curves, exactly, but their inner control points are implied by the sides
 //! rather than the surface's, so colours inside a patch sit up to a fraction of a pixel from
 //! where the PDF (type 7, all sixteen points) puts them.
+//!
+//! A translucent layer's meshes are written opaque, and its opacity goes into a luminance mask
+//! of the same meshes in grey (as the PDF's soft mask): Inkscape paints each mesh gradient
+//! separately, and two translucent ones overlap along their common side, which would show as
+//! a grid of darker seams. Opaque ones overlapping repaint the same colour.
+//!
+//! The PNG fallback is masked so that only viewers without mesh gradients show it: the mask is
+//! a rectangle painted with a black mesh gradient whose fallback colour is white. A viewer that
+//! draws mesh gradients (Inkscape) paints the mask black and hides the PNG; one that does not
+//! (browsers, resvg) paints it white and shows the PNG. The meshes and the PNG never both show,
+//! which would draw translucent layers twice.
 
 use std::fmt::Write as _;
 
 use super::split::{OutPatch, Target};
 use super::surface::Curve;
-use super::{layer_patches, ExportInfo, ExportOptions};
+use super::{layer_patches, ExportInfo, ExportOptions, LayerPatches};
 use crate::error::Error;
 use crate::mesh::Document;
 use crate::render::{encode_png, render_image, PngDepth, RenderOptions};
 
+/// What a mesh gradient paints: a layer's colours, or its opacity as grey (in the layer's
+/// luminance mask).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Paint {
+    Colour,
+    Opacity,
+}
+
 /// The document as an SVG of the page size ([`ExportOptions::page_size_px`]) in CSS pixels,
-/// drawn on a grid of `opts.width` x `opts.height`, with a PNG of the render
-/// beneath the meshes when `fallback` is set (browsers show it; Inkscape draws the meshes
-/// over it), and what was written.
+/// drawn on a grid of `opts.width` x `opts.height`, and what was written. With `fallback`, a
+/// PNG of the render lies beneath the meshes for viewers that do not draw mesh gradients
+/// (browsers); a mask hides it from those that do (Inkscape).
 pub fn write_svg(
     doc: &Document,
     opts: &ExportOptions,
@@ -35,35 +54,96 @@ pub fn write_svg(
         r#"<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" width="{page_w}" height="{page_h}" viewBox="0 0 {w} {h}">"#
     );
     if fallback {
-        let (image, _) = render_image(doc, &RenderOptions::new(w, h, opts.view))?;
-        let png = encode_png(&image, PngDepth::Eight { dither: true })?;
-        let _ = writeln!(
-            out,
-            r#"<image width="{w}" height="{h}" xlink:href="data:image/png;base64,{}"/>"#,
-            base64(&png)
-        );
+        write_fallback(&mut out, doc, opts)?;
     }
     let mut mesh_id = 0usize;
     for (k, layer) in layers.iter().enumerate() {
-        if layer.patches.is_empty() {
-            continue;
+        if !layer.patches.is_empty() {
+            write_layer(&mut out, k, layer, (w, h), &mut mesh_id);
         }
-        let _ = writeln!(
-            out,
-            r#"<clipPath id="outline{k}"><path clip-rule="nonzero" d="{}"/></clipPath>"#,
-            outline_path(&layer.outline)
-        );
-        let _ = writeln!(out, r#"<g clip-path="url(#outline{k})">"#);
-        for grid in &layer.grids {
-            let cells = &layer.patches[grid.first..grid.first + grid.n * grid.m];
-            write_mesh(&mut out, mesh_id, cells, grid.n, grid.m);
-            mesh_id += 1;
-        }
-        out.push_str("</g>\n");
     }
     out.push_str("</svg>\n");
     info.seconds += start.elapsed().as_secs_f64();
     Ok((out.into_bytes(), info))
+}
+
+/// The page grown by a pixel on every side, as a mask's region: the edges of what a mask
+/// holds then lie outside the page.
+fn page_region((w, h): (u32, u32)) -> String {
+    format!(r#"x="-1" y="-1" width="{}" height="{}""#, w + 2, h + 2)
+}
+
+/// The PNG of the render, masked so that viewers that draw mesh gradients hide it (see the
+/// module's notes).
+fn write_fallback(out: &mut String, doc: &Document, opts: &ExportOptions) -> Result<(), Error> {
+    let (w, h) = (opts.width, opts.height);
+    let (image, _) = render_image(doc, &RenderOptions::new(w, h, opts.view))?;
+    let png = encode_png(&image, PngDepth::Eight { dither: true })?;
+    let (bw, bh) = (w + 2, h + 2);
+    let black = r##"stop-color="#000000""##;
+    let _ = writeln!(
+        out,
+        r#"<meshgradient id="fallback-hider" gradientUnits="userSpaceOnUse" x="-1" y="-1"><meshrow><meshpatch><stop path="c 0,0 {bw},0 {bw},0" {black}/><stop path="c 0,0 0,{bh} 0,{bh}" {black}/><stop path="c 0,0 -{bw},0 -{bw},0" {black}/><stop path="c 0,0 0,-{bh} 0,-{bh}" {black}/></meshpatch></meshrow></meshgradient>"#
+    );
+    let region = page_region((w, h));
+    let _ = writeln!(
+        out,
+        r##"<mask id="fallback" maskUnits="userSpaceOnUse" {region}><rect {region} fill="url(#fallback-hider) #ffffff"/></mask>"##
+    );
+    let _ = writeln!(
+        out,
+        r#"<image width="{w}" height="{h}" mask="url(#fallback)" xlink:href="data:image/png;base64,{}"/>"#,
+        base64(&png)
+    );
+    Ok(())
+}
+
+/// Layer `k`: its outline as a clip path, its meshes (`mesh{id}`, numbered on from `mesh_id`)
+/// in a group clipped to it, and for a translucent layer its opacity as a luminance mask of
+/// grey meshes (`opacity-mesh{id}`) on that group.
+fn write_layer(
+    out: &mut String,
+    k: usize,
+    layer: &LayerPatches,
+    page: (u32, u32),
+    mesh_id: &mut usize,
+) {
+    let _ = writeln!(
+        out,
+        r#"<clipPath id="outline{k}"><path clip-rule="nonzero" d="{}"/></clipPath>"#,
+        outline_path(&layer.outline)
+    );
+    if layer.masked {
+        let _ = writeln!(
+            out,
+            r#"<mask id="layer-opacity{k}" maskUnits="userSpaceOnUse" {}>"#,
+            page_region(page)
+        );
+        write_meshes(out, layer, *mesh_id, Paint::Opacity);
+        out.push_str("</mask>\n");
+        let _ = writeln!(
+            out,
+            r#"<g clip-path="url(#outline{k})" mask="url(#layer-opacity{k})">"#
+        );
+    } else {
+        let _ = writeln!(out, r#"<g clip-path="url(#outline{k})">"#);
+    }
+    write_meshes(out, layer, *mesh_id, Paint::Colour);
+    *mesh_id += layer.grids.len();
+    out.push_str("</g>\n");
+}
+
+/// Every split grid of `layer` as a mesh gradient painting `paint`, numbered from `first`.
+fn write_meshes(out: &mut String, layer: &LayerPatches, first: usize, paint: Paint) {
+    let prefix = match paint {
+        Paint::Colour => "mesh",
+        Paint::Opacity => "opacity-mesh",
+    };
+    for (i, grid) in layer.grids.iter().enumerate() {
+        let cells = &layer.patches[grid.first..grid.first + grid.n * grid.m];
+        let id = format!("{prefix}{}", first + i);
+        write_mesh(out, &id, cells, (grid.n, grid.m), paint);
+    }
 }
 
 /// The loops of `outline` as path data.
@@ -110,24 +190,33 @@ fn side(cell: &OutPatch, points: [(usize, usize); 4]) -> String {
     format!("c {} {} {}", rel(p[1]), rel(p[2]), rel(p[3]))
 }
 
-/// The stop colour of corner `c` of `cell`.
-fn stop(cell: &OutPatch, c: usize) -> String {
-    let hex = cell.colours[c].map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8);
-    let colour = format!("#{:02x}{:02x}{:02x}", hex[0], hex[1], hex[2]);
-    let alpha = cell.opacity[c].clamp(0.0, 1.0);
-    if alpha < 1.0 {
-        format!(r#"stop-color="{colour}" stop-opacity="{}""#, num(alpha))
-    } else {
-        format!(r#"stop-color="{colour}""#)
-    }
+/// The stop colour of corner `c` of `cell`: its colour, or its opacity as grey. Opacity is
+/// never a stop's own (`stop-opacity`): see the module's notes.
+fn stop(cell: &OutPatch, c: usize, paint: Paint) -> String {
+    let rgb = match paint {
+        Paint::Colour => cell.colours[c],
+        Paint::Opacity => [cell.opacity[c]; 3],
+    };
+    let hex = rgb.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8);
+    format!(
+        r##"stop-color="#{:02x}{:02x}{:02x}""##,
+        hex[0], hex[1], hex[2]
+    )
 }
 
-/// The `n x m` cells (row by row) of one split patch as a mesh gradient, and a box it fills.
-fn write_mesh(out: &mut String, id: usize, cells: &[OutPatch], n: usize, m: usize) {
+/// The `n x m` cells (row by row) of one split patch as mesh gradient `id` painting `paint`,
+/// and a box it fills.
+fn write_mesh(
+    out: &mut String,
+    id: &str,
+    cells: &[OutPatch],
+    (n, m): (usize, usize),
+    paint: Paint,
+) {
     let origin = cells[0].points[0][0];
     let _ = writeln!(
         out,
-        r#"<meshgradient id="mesh{id}" gradientUnits="userSpaceOnUse" x="{}" y="{}">"#,
+        r#"<meshgradient id="{id}" gradientUnits="userSpaceOnUse" x="{}" y="{}">"#,
         num(origin[0]),
         num(origin[1])
     );
@@ -147,7 +236,7 @@ fn write_mesh(out: &mut String, id: usize, cells: &[OutPatch], n: usize, m: usiz
                     out,
                     r#"<stop path="{}" {}/>"#,
                     side(cell, points),
-                    stop(cell, corner)
+                    stop(cell, corner, paint)
                 );
             };
             if r == 0 {
@@ -173,7 +262,7 @@ fn write_mesh(out: &mut String, id: usize, cells: &[OutPatch], n: usize, m: usiz
     // A pixel wider than the mesh: its edge's anti-aliasing falls where the mesh paints nothing.
     let _ = writeln!(
         out,
-        r#"<rect x="{}" y="{}" width="{}" height="{}" fill="url(#mesh{id}) none"/>"#,
+        r#"<rect x="{}" y="{}" width="{}" height="{}" fill="url(#{id}) none"/>"#,
         num(lo[0] - 1.0),
         num(lo[1] - 1.0),
         num(hi[0] - lo[0] + 2.0),

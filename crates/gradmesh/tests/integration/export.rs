@@ -84,6 +84,9 @@ pub enum Tool {
     Ghostscript,
     /// For SVG.
     Inkscape,
+    /// For SVG: headless Chromium's screenshot of the file (it does not draw mesh gradients, so
+    /// it shows the PNG fallback).
+    Chromium,
 }
 
 pub const TOOLS: [Tool; 3] = [Tool::Mutool, Tool::Pdftoppm, Tool::Ghostscript];
@@ -95,6 +98,7 @@ impl Tool {
             Tool::Pdftoppm => ("pdftoppm", "poppler-utils"),
             Tool::Ghostscript => ("gs", "ghostscript"),
             Tool::Inkscape => ("inkscape", "inkscape"),
+            Tool::Chromium => ("chromium", "chromium"),
         }
     }
 
@@ -130,6 +134,22 @@ impl Tool {
                 .args(["--export-type=png", "--export-dpi=96"])
                 .arg(format!("--export-filename={}", out.display()))
                 .arg(pdf),
+            Tool::Chromium => {
+                let (w, h) = svg_size(pdf);
+                let profile = pdf.with_extension("chromium-profile");
+                cmd.args([
+                    "--headless=new",
+                    "--no-sandbox",
+                    "--disable-gpu",
+                    "--hide-scrollbars",
+                    "--force-device-scale-factor=1",
+                    "--default-background-color=00000000",
+                ])
+                .arg(format!("--window-size={w},{h}"))
+                .arg(format!("--user-data-dir={}", profile.display()))
+                .arg(format!("--screenshot={}", out.display()))
+                .arg(format!("file://{}", pdf.display()))
+            }
         };
         let status = cmd.output().unwrap_or_else(|e| {
             panic!("{program} could not be run ({e}): install it (apt-get install {package})")
@@ -147,6 +167,23 @@ impl Tool {
     fn has_alpha(self) -> bool {
         self != Tool::Pdftoppm
     }
+}
+
+/// The `width` and `height` of an SVG file's root, in whole CSS pixels.
+fn svg_size(svg: &Path) -> (u32, u32) {
+    let text = std::fs::read_to_string(svg).unwrap();
+    let root = &text[text.find("<svg").expect("an <svg> root")..];
+    let root = &root[..root.find('>').unwrap()];
+    let attribute = |name: &str| -> u32 {
+        let start = root
+            .find(&format!(" {name}=\""))
+            .unwrap_or_else(|| panic!("the root has no {name}"))
+            + name.len()
+            + 3;
+        let value = &root[start..start + root[start..].find('"').unwrap()];
+        value.parse::<f64>().unwrap().round() as u32
+    };
+    (attribute("width"), attribute("height"))
 }
 
 /// How a rasterised PDF compares with gradmesh's render.
@@ -273,6 +310,18 @@ pub fn check_svg(doc: &Document, opts: &ExportOptions, name: &str) -> (Compariso
     (results[0].1, bytes)
 }
 
+/// As [`check_document`], for an SVG with its PNG fallback (as the command line writes it),
+/// drawn by Inkscape (which should draw the meshes alone) and Chromium (the fallback alone).
+pub fn check_svg_with_fallback(
+    doc: &Document,
+    opts: &ExportOptions,
+    name: &str,
+) -> Vec<(Tool, Comparison)> {
+    let written = write_svg(doc, opts, true).unwrap();
+    let tools = [Tool::Inkscape, Tool::Chromium];
+    check_file(doc, opts, name, "svg", written, &tools).0
+}
+
 fn check_file(
     doc: &Document,
     opts: &ExportOptions,
@@ -361,7 +410,7 @@ fn assert_close(name: &str, results: &[(Tool, Comparison)], bar: impl Fn(Tool) -
 fn mask_bar(tool: Tool) -> (f64, f64) {
     match tool {
         Tool::Pdftoppm => (5.0, 40.0),
-        Tool::Mutool | Tool::Ghostscript | Tool::Inkscape => (1.0, 3.0),
+        Tool::Mutool | Tool::Ghostscript | Tool::Inkscape | Tool::Chromium => (1.0, 3.0),
     }
 }
 
@@ -370,7 +419,7 @@ fn mask_bar(tool: Tool) -> (f64, f64) {
 fn lab_bar(tool: Tool) -> (f64, f64) {
     match tool {
         Tool::Pdftoppm => (1.0, 3.0),
-        Tool::Mutool | Tool::Ghostscript | Tool::Inkscape => (6.0, 12.0),
+        Tool::Mutool | Tool::Ghostscript | Tool::Inkscape | Tool::Chromium => (6.0, 12.0),
     }
 }
 
@@ -535,9 +584,54 @@ fn svg_mesh_gradients_match_the_render_in_inkscape() {
     }
 }
 
+/// `examples/irregular-vertex.json` with corners 35 to 80 % opaque.
+fn translucent_star() -> GradientMesh {
+    let mut star = example("irregular-vertex.json").layers.remove(0);
+    for (i, p) in star.points.iter_mut().enumerate() {
+        p.opacity = [0.35, 0.5, 0.65, 0.8, 0.45, 0.6][i % 6];
+    }
+    star
+}
+
+/// [`translucent_star`] over the opaque `examples/rectangle.json`, its lowest tip over the
+/// page.
+fn translucent_example() -> Document {
+    let mut doc = example("rectangle.json");
+    doc.layers.push(translucent_star());
+    doc
+}
+
+/// A translucent layer alone and over opaque ones, in the SVG as the command line writes it
+/// (with the PNG fallback): Inkscape draws the meshes alone, Chromium the PNG alone, and
+/// without the fallback Inkscape draws the same. Inkscape drawing the PNG beneath the meshes
+/// would show the translucent star twice (mean ΔE00 13.7), and translucent meshes overlapping
+/// along their sides would draw a grid of seams.
 #[test]
-fn svg_fallback_is_a_png_beneath_the_meshes() {
-    let doc = example("irregular-vertex.json");
+fn translucent_svg_matches_the_render_in_inkscape_and_chromium() {
+    let star = Document {
+        layers: vec![translucent_star()],
+    };
+    for (name, doc) in [
+        ("translucent-star", star),
+        ("translucent-example", translucent_example()),
+        ("translucent", translucent_document()),
+    ] {
+        let render = RenderOptions::fit(&doc, 256);
+        let opts = ExportOptions::new(render.width, render.height, render.view);
+        let results = check_svg_with_fallback(&doc, &opts, &format!("{name}-svg"));
+        assert_close(&format!("{name} SVG with its fallback"), &results, strict);
+        let (alone, _) = check_svg(&doc, &opts, &format!("{name}-svg-alone"));
+        assert_close(
+            &format!("{name} SVG without fallback"),
+            &[(Tool::Inkscape, alone)],
+            strict,
+        );
+    }
+}
+
+#[test]
+fn svg_fallback_is_a_png_hidden_where_meshes_are_drawn() {
+    let doc = translucent_document();
     let render = RenderOptions::fit(&doc, 64);
     let opts = ExportOptions::new(render.width, render.height, render.view);
     let (with, _) = write_svg(&doc, &opts, true).unwrap();
@@ -549,9 +643,19 @@ fn svg_fallback_is_a_png_beneath_the_meshes() {
     let image = with
         .find("data:image/png;base64,")
         .expect("an embedded PNG");
-    assert!(image < with.find("<meshgradient").unwrap());
+    assert!(image < with.find(r#"<meshgradient id="mesh0""#).unwrap());
+    // The PNG is masked by a rectangle painted with a mesh gradient, white where a viewer
+    // cannot draw it.
+    assert!(with.contains(r#"<image width="64" height="64" mask="url(#fallback)""#));
+    assert!(with.contains(r#"fill="url(#fallback-hider) #ffffff""#));
+    assert!(with.contains(r#"<meshgradient id="fallback-hider""#));
     assert!(with.contains(r#"fill="url(#mesh0) none""#));
-    assert!(!without.contains("<image"));
+    assert!(!without.contains("<image") && !without.contains("fallback"));
+    // The translucent layer's meshes are opaque, its opacity in a mask of grey meshes.
+    assert!(!with.contains("stop-opacity"));
+    assert!(with.contains(r#"<g clip-path="url(#outline1)" mask="url(#layer-opacity1)">"#));
+    assert!(with.contains(r#"fill="url(#opacity-mesh"#));
+    assert!(!with.contains(r#"mask="url(#layer-opacity0)""#));
 }
 
 /// The figures of docs/export.md for the real artwork: patches, bytes and time, and each
