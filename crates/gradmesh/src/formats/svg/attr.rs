@@ -24,8 +24,7 @@ pub(super) fn describe(node: Node) -> String {
 
 /// The line and column (1-based) where the element starts.
 pub(super) fn line_column(node: Node) -> (usize, usize) {
-    let pos = node.document().text_pos_at(node.range().start);
-    (pos.row as usize, pos.col as usize)
+    super::lines::line_column(node.document(), node.range().start)
 }
 
 /// An error about `node`: located at its line, the message naming the element and its column.

@@ -30,6 +30,7 @@
 mod attr;
 mod convert;
 mod gradient;
+mod lines;
 mod read;
 mod scene;
 mod shape;

@@ -56,6 +56,7 @@ pub fn read_svg_with_limits(text: &str, limits: &Limits) -> Result<SvgScene, Err
         location: Location::default().at_line(e.pos().row as usize),
         kind: ErrorKind::Syntax(format!("the file is not well-formed XML: {e}")),
     })?;
+    let _lines = super::lines::LineIndex::new(&doc);
     let root = doc.root_element();
     if !is_svg_element(root, &["svg"]) {
         return Err(error_at(root, "the root element is not <svg>"));
