@@ -450,6 +450,78 @@ fn exported_svg_reads_back_as_the_png_of_its_layers() {
     }
 }
 
+/// A translucent layer (`examples/irregular-vertex.json` with corners 35 to 80 % opaque) over
+/// an opaque one, exported as SVG with its PNG fallback and rendered back: the picture is the
+/// direct render's. The masks the export writes are read into the layer's opacity, and the
+/// PNG fallback stays hidden, as in any viewer that draws mesh gradients.
+#[test]
+fn exported_translucent_svg_reads_back_as_the_png() {
+    let dir = tempfile::tempdir().unwrap();
+    let examples = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples"));
+    let mut star: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(examples.join("irregular-vertex.json")).unwrap(),
+    )
+    .unwrap();
+    let points = star["layers"][0]["points"].as_array_mut().unwrap();
+    for (i, p) in points.iter_mut().enumerate() {
+        p["opacity"] = [0.35, 0.5, 0.65, 0.8, 0.45, 0.6][i % 6].into();
+    }
+    let star_path = dir.path().join("star.json");
+    std::fs::write(&star_path, star.to_string()).unwrap();
+    let rectangle = examples.join("rectangle.json");
+    let run = |args: &[&str]| {
+        let o = gradmesh(args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    let (png, svg, back) = (
+        dir.path().join("direct.png"),
+        dir.path().join("exported.svg"),
+        dir.path().join("back.png"),
+    );
+    let inputs = [rectangle.to_str().unwrap(), star_path.to_str().unwrap()];
+    for out in [&png, &svg] {
+        let mut args = vec!["render"];
+        args.extend(inputs);
+        args.extend(["-o", out.to_str().unwrap(), "--width", "256"]);
+        run(&args);
+    }
+    run(&[
+        "render",
+        svg.to_str().unwrap(),
+        "-o",
+        back.to_str().unwrap(),
+    ]);
+    let (w, h, direct) = decode_png(&png);
+    let (bw, bh, read_back) = decode_png(&back);
+    assert_eq!((bw, bh), (w, h));
+    // Per pixel covered in either, the mean difference of the premultiplied channels (a
+    // colour under little alpha weighs little), in levels.
+    let pre = |p: &[u8], c: usize| p[c] as f64 * p[3] as f64 / 255.0;
+    let mut differences: Vec<f64> = direct
+        .chunks_exact(4)
+        .zip(read_back.chunks_exact(4))
+        .filter(|(a, b)| a[3] > 0 || b[3] > 0)
+        .map(|(a, b)| {
+            let colour: f64 = (0..3).map(|c| (pre(a, c) - pre(b, c)).abs()).sum();
+            (colour + (a[3] as f64 - b[3] as f64).abs()) / 4.0
+        })
+        .collect();
+    differences.sort_by(f64::total_cmp);
+    let n = differences.len();
+    let mean = differences.iter().sum::<f64>() / n as f64;
+    let p95 = differences[n * 95 / 100];
+    eprintln!("{n} pixels: mean difference {mean:.2} levels, 95th percentile {p95:.2}");
+    // The outline differs by up to a pixel (the reader leaves out the layer's clip path, and
+    // draws a mesh's edge without anti-aliasing), so the percentile is not the 99th. The PNG
+    // fallback drawn beneath the meshes gives a mean of 3.7 and a 95th percentile of 33; the
+    // layer read opaque, 18.5 and 64.
+    assert!(n > 30_000, "{n} pixels covered");
+    assert!(
+        mean < 1.5 && p95 < 8.0,
+        "mean {mean}, 95th percentile {p95} levels"
+    );
+}
+
 /// A file whose mesh fills alternate with other content by the thousand: each part between
 /// them would be a copy of the file for resvg to parse, so above the limit only the mesh fills
 /// are drawn, with a warning that says why.

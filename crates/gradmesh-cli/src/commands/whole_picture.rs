@@ -201,6 +201,23 @@ struct Segments<'a, 'input> {
     drawing: Vec<bool>,
     /// The root's edits that show the render's view at its size.
     root: Vec<Edit>,
+    /// The edits that hide the mesh-filled shapes inside masks ([`masked_mesh_shapes`]).
+    masked: Vec<Edit>,
+}
+
+/// Edits hiding (`display:none`) the shapes inside `<mask>` elements whose fill is one of
+/// `mesh_ids`. resvg draws no mesh gradient, so it would paint such a shape's fallback colour.
+/// gradmesh reads a mask of mesh gradients into the opacity of the meshes it masks
+/// (`formats::svg`), and where a mask of mesh gradients masks other content (gradmesh's SVG
+/// export hides its PNG fallback from viewers that draw mesh gradients so), that content is
+/// masked as by a mask that paints nothing.
+fn masked_mesh_shapes(doc: &Document, text: &str, mesh_ids: &HashSet<&str>) -> Vec<Edit> {
+    let is_mask = |n: Node| is_svg(n) && n.tag_name().name() == "mask";
+    doc.descendants()
+        .filter(|n| is_svg(*n) && SHAPES.contains(&n.tag_name().name()))
+        .filter(|n| n.ancestors().skip(1).any(is_mask) && fills_with_mesh(mesh_ids, *n))
+        .map(|n| add_style(n, text, "display:none"))
+        .collect()
 }
 
 /// Whether `node` may be stroked: its own or an inherited `stroke` other than `none`, or any
@@ -257,12 +274,14 @@ impl<'a, 'input> Segments<'a, 'input> {
             }
         }
         let root = root_view(doc.root_element(), text, opts);
+        let masked = masked_mesh_shapes(doc, text, &drawn.mesh_ids);
         Ok(Segments {
             text,
             drawn,
             is_mesh_shape,
             drawing,
             root,
+            masked,
         })
     }
 
@@ -274,6 +293,7 @@ impl<'a, 'input> Segments<'a, 'input> {
         let mut edits: Vec<Edit> = self
             .root
             .iter()
+            .chain(&self.masked)
             .map(|e| Edit {
                 range: e.range.clone(),
                 with: e.with.clone(),

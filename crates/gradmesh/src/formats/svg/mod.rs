@@ -31,6 +31,7 @@ mod attr;
 mod convert;
 mod gradient;
 mod lines;
+mod mask;
 mod read;
 mod scene;
 mod shape;

@@ -8,6 +8,7 @@ use roxmltree::{Document, Node, ParsingOptions};
 
 use super::attr::{self, error_at, is_svg_element, warning_at};
 use super::gradient::{self, Units};
+use super::mask;
 use super::scene::{AspectRatio, FillRule, MeshFill, MeshGrid, SvgScene};
 use super::shape;
 use crate::error::{Error, ErrorKind, Location, Warning, WarningKind};
@@ -215,6 +216,7 @@ impl<'a, 'input> Reader<'a, 'input> {
             let child_ctm = ctm * self.or_ignored(child, transform, Affine::IDENTITY);
             let own_opacity = attr::own_opacity(child, "opacity");
             let child_opacity = opacity * self.or_ignored(child, own_opacity, 1.0);
+            let first_fill = self.fills.len();
             match child.tag_name().name() {
                 "g" | "a" | "switch" => self.walk(child, child_ctm, child_opacity, depth + 1)?,
                 name if shape::SHAPES.contains(&name) => {
@@ -227,8 +229,103 @@ impl<'a, 'input> Reader<'a, 'input> {
                     "left out: only shapes filled with mesh gradients are read",
                 )),
             }
+            if let Some(mask) = attr::own_property(child, "mask").filter(|m| *m != "none") {
+                self.mask(child, mask, child_ctm, first_fill)?;
+            }
         }
         Ok(())
+    }
+
+    /// The mask `reference` of `node` (whose user space `ctm` maps to the root's), over the
+    /// mesh fills read from it (`self.fills[first..]`): a mask of mesh gradients that match
+    /// them patch for patch is read into their corners' opacity; any other mask over mesh fills
+    /// is left out with a warning.
+    fn mask(
+        &mut self,
+        node: Node<'a, 'input>,
+        reference: &str,
+        ctm: Affine,
+        first: usize,
+    ) -> Result<(), Error> {
+        if self.fills.len() == first {
+            return Ok(());
+        }
+        let masks = self.mask_meshes(reference, ctm)?;
+        if !masks.is_some_and(|m| mask::apply_luminance_mask(&mut self.fills[first..], &m)) {
+            self.warnings.push(warning_at(
+                node,
+                WarningKind::SvgReadDifferently,
+                format!(
+                    "mask {reference:?} left out: only a mask of mesh gradients matching its \
+                     mesh fills patch for patch is read (gradmesh's SVG export writes a \
+                     translucent layer so)"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The meshes, in root units, of the drawn children of the `<mask>` that `reference`
+    /// (`url(#id)`) names in a user space `ctm` maps to the root's; `None` unless that mask
+    /// exists, has user-space content, and every drawn child is a shape filled with a mesh
+    /// gradient that can be read.
+    fn mask_meshes(
+        &mut self,
+        reference: &str,
+        ctm: Affine,
+    ) -> Result<Option<Vec<MeshGrid>>, Error> {
+        let id = match svgtypes::Paint::from_str(reference) {
+            Ok(svgtypes::Paint::FuncIRI(id, _)) => id,
+            _ => return Ok(None),
+        };
+        let Some(mask) = self.ids.get(id).copied() else {
+            return Ok(None);
+        };
+        if !is_svg_element(mask, &["mask"])
+            || mask.attribute("maskContentUnits") == Some("objectBoundingBox")
+        {
+            return Ok(None);
+        }
+        let mut grids = Vec::new();
+        let drawn = mask.children().filter(|n| {
+            n.is_element()
+                && !is_svg_element(*n, &NOT_DRAWN)
+                && attr::own_property(*n, "display") != Some("none")
+        });
+        for shape in drawn {
+            let Some(mesh) = self.mask_mesh(shape)? else {
+                return Ok(None);
+            };
+            grids.push(transformed(mesh, ctm));
+        }
+        Ok(Some(grids))
+    }
+
+    /// The mesh of a shape inside a mask, in the mask's user space; `None` unless it is a
+    /// shape filled with a mesh gradient that can be read.
+    fn mask_mesh(&mut self, shape: Node<'a, 'input>) -> Result<Option<MeshGrid>, Error> {
+        if !is_svg_element(shape, &shape::SHAPES) {
+            return Ok(None);
+        }
+        let fill = attr::inherited_property(shape, "fill").unwrap_or("black");
+        let gradient = match svgtypes::Paint::from_str(fill) {
+            Ok(svgtypes::Paint::FuncIRI(id, _)) => self.ids.get(id).copied(),
+            _ => None,
+        };
+        let Some(gradient) = gradient.filter(|g| gradient::is_mesh_gradient(*g)) else {
+            return Ok(None);
+        };
+        let (Ok(transform), Ok(Some(outline))) = (
+            attr::transform_attribute(shape, "transform"),
+            shape::outline(shape, self.percent_base),
+        ) else {
+            return Ok(None);
+        };
+        match self.mesh_for(gradient, shape, outline.bounding_box()) {
+            Ok(mesh) => Ok(mesh.map(|m| transformed(m, transform))),
+            Err(e) if matches!(e.kind, ErrorKind::LimitExceeded { .. }) => Err(e),
+            Err(_) => Ok(None),
+        }
     }
 
     /// A warning for a paint property that is set and not `none`.

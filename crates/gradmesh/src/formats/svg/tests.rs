@@ -724,3 +724,90 @@ fn warning_text(warnings: &[crate::Warning]) -> String {
     let lines: Vec<&str> = warnings.iter().map(|w| w.message.as_str()).collect();
     lines.join("\n")
 }
+
+/// A 1-patch mesh `id` over (10, 10)-(40, 40) whose four corners are `grey`.
+fn grey_gradient(id: &str, grey: &str) -> String {
+    format!(
+        r##"<meshgradient id="{id}" x="10" y="10" gradientUnits="userSpaceOnUse"><meshrow><meshpatch>
+        <stop path="l 30,0" stop-color="{grey}"/><stop path="l 0,30" stop-color="{grey}"/>
+        <stop path="l -30,0" stop-color="{grey}"/><stop path="l 0,-30" stop-color="{grey}"/>
+        </meshpatch></meshrow></meshgradient>"##
+    )
+}
+
+#[test]
+fn a_mask_of_matching_meshes_is_read_into_the_opacity() {
+    let colours = square_gradient("m", 10.0, 10.0, 30.0, "");
+    let body = |mask: &str, grey: &str| {
+        format!(
+            r#"{colours}{}<mask id="a">{mask}</mask><g mask="url(#a)"><rect x="10" y="10" width="30" height="30" fill="url(#m)"/></g>"#,
+            grey_gradient("g", grey)
+        )
+    };
+    // The mask's grey (its luminance), times its stop-opacity, multiplies each corner's opacity.
+    let scene = read(&body(
+        r#"<rect x="9" y="9" width="32" height="32" fill="url(#g) none"/>"#,
+        "#808080",
+    ));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    for corner in &scene.fills[0].mesh.corners {
+        assert!((corner.opacity - 128.0 / 255.0).abs() < 1e-9, "{corner:?}");
+    }
+    // A mask whose mesh lies elsewhere, or that holds other content, is left out and named.
+    for mask in [
+        r#"<rect x="9" y="9" width="32" height="32" fill="url(#g)" transform="translate(1 0)"/>"#,
+        r##"<rect x="9" y="9" width="32" height="32" fill="#fff"/>"##,
+    ] {
+        let scene = read(&body(mask, "#808080"));
+        assert!(scene.fills[0].mesh.corners.iter().all(|c| c.opacity == 1.0));
+        let text = warning_text(&scene.warnings);
+        assert!(text.contains("mask \"url(#a)\" left out"), "{text}");
+    }
+    // A mask over content that is not a mesh fill is not gradmesh's to read: no warning.
+    let scene = read(&format!(
+        r##"{colours}<rect x="10" y="10" width="30" height="30" fill="url(#m)"/><mask id="b"/><g mask="url(#b)"/>"##
+    ));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+}
+
+/// gradmesh's SVG export writes a translucent layer as opaque meshes with a mask of grey
+/// meshes: reading it back gives the layer its opacity again, within the 8 bits of a grey.
+#[test]
+fn an_exported_translucent_layer_reads_back_translucent() {
+    use crate::export::{write_svg, ExportOptions};
+    use crate::mesh::{Document, GradientMesh};
+    use crate::view::View;
+    let mut mesh = GradientMesh::new(crate::colour::ColourSpace::Lab);
+    let opacities = [1.0, 0.2, 0.6, 0.4];
+    let p = [(0.0, 0.0), (100.0, 0.0), (100.0, 100.0), (0.0, 100.0)]
+        .map(|(x, y)| mesh.add_point(Point::new(x, y), [60.0, 20.0, 30.0]));
+    for (id, opacity) in p.iter().zip(opacities) {
+        mesh.points[*id as usize].opacity = opacity;
+    }
+    mesh.add_face(p.to_vec());
+    let doc = Document { layers: vec![mesh] };
+    let opts = ExportOptions::new(64, 64, View::new(-5.0, -5.0, 105.0, 105.0));
+    let (bytes, _) = write_svg(&doc, &opts, true).unwrap();
+    let scene = read_svg(std::str::from_utf8(&bytes).unwrap()).unwrap();
+    let text = warning_text(&scene.warnings);
+    assert!(!text.contains("mask"), "{text}");
+    assert!(!scene.fills.is_empty());
+    // The corners of the exported quad, in pixels.
+    let scale = 64.0 / 110.0;
+    let at = |x: f64, y: f64| Point::new((x + 5.0) * scale, (y + 5.0) * scale);
+    for ((x, y), opacity) in [(0.0, 0.0), (100.0, 0.0), (100.0, 100.0), (0.0, 100.0)]
+        .into_iter()
+        .zip(opacities)
+    {
+        let corner = scene
+            .fills
+            .iter()
+            .flat_map(|f| &f.mesh.corners)
+            .find(|c| c.position.distance(at(x, y)) < 2e-3)
+            .unwrap_or_else(|| panic!("no corner at ({x}, {y})"));
+        assert!(
+            (corner.opacity - opacity).abs() <= 0.5 / 255.0 + 1e-9,
+            "{corner:?}"
+        );
+    }
+}
