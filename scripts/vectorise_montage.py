@@ -27,7 +27,7 @@ def table_rows(path, stem):
 def caption(title, row):
     points, psnr, delta_e, size, seconds = row
     pts = "" if points == "–" else f"{points} pts, "
-    return f"{title}: {pts}{psnr} dB, ΔE {delta_e}, {int(size) / 1000:.1f} KB, {seconds} s"
+    return f"{title}: {pts}{psnr} dB, dE00 {delta_e}, {int(size) / 1000:.1f} KB, {seconds} s"
 
 
 def main():

@@ -9,7 +9,10 @@
 //! ```text
 //! cargo run --release -p gradmesh --example vectorise_table -- \
 //!     [--out DIR] [--vtracer DIR] [--quality fast|default|best] [--budgets 256,1024] [--only NAME]
+//!     [--fixed-points]
 //! ```
+//!
+//! `--fixed-points` leaves the points where the quadtree puts them (`fit_positions` off).
 //!
 //! `--out DIR` writes the renders (`NAME-POINTS-mesh.png`, `NAME-POINTS-grid.png`,
 //! `NAME-vtracer-PRESET.png`), the fitted documents (`NAME-POINTS-mesh.json`) and the
@@ -204,6 +207,7 @@ struct Args {
     quality: Quality,
     budgets: Vec<usize>,
     only: Option<String>,
+    fit_positions: bool,
 }
 
 fn parse_args() -> Result<Args, Box<dyn Error>> {
@@ -213,6 +217,7 @@ fn parse_args() -> Result<Args, Box<dyn Error>> {
         quality: Quality::Default,
         budgets: vec![256, 1024],
         only: None,
+        fit_positions: true,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -221,6 +226,7 @@ fn parse_args() -> Result<Args, Box<dyn Error>> {
             "--out" => args.out = Some(value()?.into()),
             "--vtracer" => args.vtracer = Some(value()?.into()),
             "--only" => args.only = Some(value()?),
+            "--fixed-points" => args.fit_positions = false,
             "--quality" => {
                 args.quality = match value()?.as_str() {
                     "fast" => Quality::Fast,
@@ -270,6 +276,7 @@ fn fit_rows(
     let options = VectoriseOptions {
         points: Some(budget),
         quality: args.quality,
+        fit_positions: args.fit_positions,
         ..VectoriseOptions::default()
     };
     let start = Instant::now();

@@ -10,8 +10,11 @@
 //! [`vectorise`] starts from a coarse grid of cells over the picture, fits the colours, and
 //! splits the cells with the largest error into four ([`quadtree`]): a cell beside split ones
 //! becomes an n-gon, which the scheme handles as any other face. It repeats until the point
-//! budget or the PSNR asked for is reached. Point positions stay where the cells put them.
+//! budget or the PSNR asked for is reached. Then the points move by damped Gauss-Newton steps
+//! ([`geometry`]), the colours solved again after each, while the error falls and the surface
+//! stays free of folds.
 
+mod geometry;
 mod image;
 mod quadtree;
 mod raster;
@@ -22,6 +25,7 @@ use std::collections::{HashMap, HashSet};
 
 use crate::colour::{srgb_encode, ColourSpace};
 use crate::error::{Error, ErrorKind};
+use crate::folds::find_folds;
 use crate::limit_surface::limit_stencils;
 use crate::mesh::{Document, FirstStep, GradientMesh};
 use crate::refine::Refinement;
@@ -33,6 +37,7 @@ pub use image::{psnr, RgbaImage, MAX_IMAGE_BYTES, MAX_IMAGE_PIXELS};
 use image::{psnr_of_sum, Target};
 use quadtree::{Key, Quadtree};
 use raster::Observation;
+use rows::SparseRows;
 use solve::NormalEquations;
 
 /// How much time a fit may take.
@@ -66,6 +71,15 @@ impl Quality {
         }
     }
 
+    /// Rounds of Gauss-Newton steps on the point positions.
+    fn position_rounds(self) -> usize {
+        match self {
+            Quality::Fast => 2,
+            Quality::Default => 4,
+            Quality::Best => 8,
+        }
+    }
+
     fn max_iterations(self) -> usize {
         match self {
             Quality::Fast => 60,
@@ -95,6 +109,10 @@ pub struct VectoriseOptions {
     pub max_points: usize,
     /// Cells are not split below this size, in pixels.
     pub min_cell_px: f64,
+    /// Move the points after the last split to cut the error (damped Gauss-Newton steps, the
+    /// colours solved again after each, kept only if the surface stays free of folds and the
+    /// error falls). Points on the picture's sides slide along them; its corners stay.
+    pub fit_positions: bool,
 }
 
 impl Default for VectoriseOptions {
@@ -107,6 +125,7 @@ impl Default for VectoriseOptions {
             smoothness: 1e-3,
             max_points: 1 << 15,
             min_cell_px: 3.0,
+            fit_positions: true,
         }
     }
 }
@@ -145,6 +164,8 @@ fn invalid(what: &str, message: impl Into<String>) -> Error {
 /// The colours of the points of a mesh fitted, and how the surface then sees the picture.
 struct Fitted {
     colours: Vec<[f64; 3]>,
+    /// The limit colour rows of the sampled level's vertices.
+    rows: SparseRows,
     observation: Observation,
     /// The limit colours of the sampled level's vertices.
     vertex_colours: Vec<[f64; 3]>,
@@ -236,6 +257,7 @@ fn fit_mesh(
     let vertex_colours = rows.apply(&colours);
     Ok(Fitted {
         colours,
+        rows,
         observation,
         vertex_colours,
     })
@@ -320,25 +342,7 @@ pub fn vectorise_with_progress(
     options: &VectoriseOptions,
     mut progress: impl FnMut(&Progress),
 ) -> Result<Vectorised, Error> {
-    let budget = match (options.points, options.psnr) {
-        (Some(n), _) => n,
-        (None, Some(_)) => options.max_points,
-        (None, None) => 1024,
-    };
-    if budget < 4 {
-        return Err(invalid(
-            "points",
-            format!("{budget}: at least 4 are needed"),
-        ));
-    }
-    if let Some(db) = options.psnr {
-        if !(db.is_finite() && db > 0.0) {
-            return Err(invalid("psnr", format!("{db}: a positive number of dB")));
-        }
-    }
-    if image.width == 0 || image.height == 0 {
-        return Err(invalid("image", "the picture is empty"));
-    }
+    let budget = checked_budget(image, options)?;
     let (w, h) = (image.width as f64, image.height as f64);
     let space = options.colour_space;
     let target = Target::new(image, space);
@@ -361,23 +365,9 @@ pub fn vectorise_with_progress(
     let mut round = 0;
     loop {
         let shape = tree.mesh();
-        let mut mesh = GradientMesh::new(space);
-        mesh.name = Some("vectorised".into());
-        for (k, p) in shape.keys.iter().zip(&shape.positions) {
-            let colour = known
-                .get(k)
-                .copied()
-                .unwrap_or_else(|| target_colour_at(&target, *p));
-            mesh.add_point(*p, colour);
-        }
-        for f in shape.faces {
-            mesh.add_face(f);
-        }
+        let mesh = tree_mesh(&shape, &known, &target, space);
         let guess = mesh.points.iter().map(|p| p.colour).collect();
         let fitted = fit_mesh(&mesh, &target, &settings, guess)?;
-        for (p, c) in mesh.points.iter_mut().zip(&fitted.colours) {
-            p.colour = *c;
-        }
         known = shape
             .keys
             .iter()
@@ -385,8 +375,7 @@ pub fn vectorise_with_progress(
             .zip(fitted.colours.iter().copied())
             .collect();
         let errors = pixel_errors(&fitted, &target, image, space);
-        let total: f64 = errors.iter().map(|e| e.unwrap_or(0.0)).sum();
-        let model_psnr = psnr_of_sum(total, 3 * errors.len());
+        let model_psnr = psnr_of_errors(&errors);
         round += 1;
         progress(&Progress {
             round,
@@ -400,10 +389,216 @@ pub fn vectorise_with_progress(
             choose_splits(&tree, &fitted, &errors, budget, quality.growth(), min_px)
         };
         if chosen.is_empty() {
-            return finish(mesh, image, round);
+            let mut fit = Fit {
+                mesh,
+                fitted,
+                error: psnr_sum(&errors),
+            };
+            if options.fit_positions {
+                round += fit.move_points_rounds(
+                    &target,
+                    image,
+                    &settings,
+                    quality,
+                    round,
+                    &mut progress,
+                )?;
+            }
+            fit.set_colours();
+            return finish(fit.mesh, image, round);
         }
         tree.split(&chosen);
     }
+}
+
+/// The mesh of a quadtree's `shape`: one face per leaf, its points coloured as `known` (by
+/// key) or else as the picture under them.
+fn tree_mesh(
+    shape: &quadtree::TreeMesh,
+    known: &HashMap<Key, [f64; 3]>,
+    target: &Target,
+    space: ColourSpace,
+) -> GradientMesh {
+    let mut mesh = GradientMesh::new(space);
+    mesh.name = Some("vectorised".into());
+    for (k, p) in shape.keys.iter().zip(&shape.positions) {
+        let colour = known
+            .get(k)
+            .copied()
+            .unwrap_or_else(|| target_colour_at(target, *p));
+        mesh.add_point(*p, colour);
+    }
+    for f in &shape.faces {
+        mesh.add_face(f.clone());
+    }
+    mesh
+}
+
+/// The point budget `options` give, after checking them and the picture.
+fn checked_budget(image: &RgbaImage, options: &VectoriseOptions) -> Result<usize, Error> {
+    let budget = match (options.points, options.psnr) {
+        (Some(n), _) => n,
+        (None, Some(_)) => options.max_points,
+        (None, None) => 1024,
+    };
+    if budget < 4 {
+        return Err(invalid(
+            "points",
+            format!("{budget}: at least 4 are needed"),
+        ));
+    }
+    if let Some(db) = options.psnr {
+        if !(db.is_finite() && db > 0.0) {
+            return Err(invalid("psnr", format!("{db}: a positive number of dB")));
+        }
+    }
+    if image.width == 0 || image.height == 0 {
+        return Err(invalid("image", "the picture is empty"));
+    }
+    Ok(budget)
+}
+
+/// The sum of squared errors of [`pixel_errors`].
+fn psnr_sum(errors: &[Option<f64>]) -> f64 {
+    errors.iter().map(|e| e.unwrap_or(0.0)).sum()
+}
+
+/// PSNR of [`pixel_errors`] over every pixel (uncovered ones count as no error).
+fn psnr_of_errors(errors: &[Option<f64>]) -> f64 {
+    psnr_of_sum(psnr_sum(errors), 3 * errors.len())
+}
+
+/// A mesh, its colour fit and the fit's summed squared 8-bit error.
+struct Fit {
+    mesh: GradientMesh,
+    fitted: Fitted,
+    error: f64,
+}
+
+impl Fit {
+    /// The fitted colours written into the mesh.
+    fn set_colours(&mut self) {
+        for (p, c) in self.mesh.points.iter_mut().zip(&self.fitted.colours) {
+            p.colour = *c;
+        }
+    }
+
+    /// Up to `quality`'s rounds of [`Fit::move_points`], until one keeps no step; reports
+    /// each kept round to `progress`, numbered on from `rounds_before`. Returns the rounds kept.
+    fn move_points_rounds(
+        &mut self,
+        target: &Target,
+        image: &RgbaImage,
+        settings: &FitSettings,
+        quality: Quality,
+        rounds_before: usize,
+        progress: &mut impl FnMut(&Progress),
+    ) -> Result<usize, Error> {
+        let mut kept = 0;
+        while kept < quality.position_rounds() && self.move_points(target, image, settings)? {
+            kept += 1;
+            progress(&Progress {
+                round: rounds_before + kept,
+                points: self.mesh.points.len(),
+                psnr: psnr_of_sum(self.error, 3 * image.pixels.len()),
+            });
+        }
+        Ok(kept)
+    }
+
+    /// One round of Gauss-Newton steps on the positions ([`geometry`]), each at most a quarter
+    /// of the point's shortest edge, tried at full, half and quarter length. Where a step
+    /// folds the surface, the points of the folded faces stay and the rest is tried again (at
+    /// most [`FOLD_RETRIES`] times). The first step that leaves the surface free of folds and,
+    /// with the colours solved again, the error lower is kept. Returns whether one was.
+    fn move_points(
+        &mut self,
+        target: &Target,
+        image: &RgbaImage,
+        settings: &FitSettings,
+    ) -> Result<bool, Error> {
+        let mut steps = geometry::position_steps(
+            &self.fitted.rows,
+            &self.fitted.observation,
+            &self.fitted.vertex_colours,
+            target,
+            self.mesh.points.len(),
+            0.1,
+        );
+        limit_steps(
+            &self.mesh,
+            &mut steps,
+            target.width as f64,
+            target.height as f64,
+        );
+        for scale in [1.0, 0.5, 0.25] {
+            let mut frozen = vec![false; steps.len()];
+            for _ in 0..=FOLD_RETRIES {
+                let mut trial = self.mesh.clone();
+                for (i, p) in trial.points.iter_mut().enumerate() {
+                    if !frozen[i] {
+                        p.position += kurbo::Vec2::new(steps[i][0], steps[i][1]) * scale;
+                    }
+                }
+                let folds = find_folds(&trial)?;
+                if !folds.is_empty() {
+                    for f in folds.iter().flat_map(|f| &f.faces) {
+                        for &v in &trial.faces[*f] {
+                            frozen[v as usize] = true;
+                        }
+                    }
+                    continue;
+                }
+                let fitted = fit_mesh(&trial, target, settings, self.fitted.colours.clone())?;
+                let error = psnr_sum(&pixel_errors(&fitted, target, image, trial.colour_space));
+                if error < self.error {
+                    *self = Fit {
+                        mesh: trial,
+                        fitted,
+                        error,
+                    };
+                    return Ok(true);
+                }
+                break;
+            }
+        }
+        Ok(false)
+    }
+}
+
+/// How often [`Fit::move_points`] freezes the points of folded faces and tries again.
+const FOLD_RETRIES: usize = 3;
+
+/// Shortens each step to at most a quarter of its point's shortest edge, and keeps points on
+/// the sides of the `width` x `height` picture on them (its corners where they are).
+fn limit_steps(mesh: &GradientMesh, steps: &mut [[f64; 2]], width: f64, height: f64) {
+    let reach = shortest_edges(mesh);
+    for ((step, p), reach) in steps.iter_mut().zip(&mesh.points).zip(reach) {
+        let length = step[0].hypot(step[1]);
+        let limit = 0.25 * reach;
+        if length > limit {
+            *step = step.map(|d| d * limit / length);
+        }
+        let q = p.position;
+        if q.x <= 1e-9 || q.x >= width - 1e-9 {
+            step[0] = 0.0;
+        }
+        if q.y <= 1e-9 || q.y >= height - 1e-9 {
+            step[1] = 0.0;
+        }
+    }
+}
+
+/// Per point, the length of its shortest edge.
+fn shortest_edges(mesh: &GradientMesh) -> Vec<f64> {
+    let mut reach = vec![f64::INFINITY; mesh.points.len()];
+    for [a, b] in mesh_edges(mesh) {
+        let (a, b) = (a as usize, b as usize);
+        let d = mesh.points[a].position.distance(mesh.points[b].position);
+        reach[a] = reach[a].min(d);
+        reach[b] = reach[b].min(d);
+    }
+    reach
 }
 
 /// The picture's colour at the pixel under `p`.
@@ -456,7 +651,14 @@ fn choose_splits(
 }
 
 /// The document of `mesh`, rendered at the picture's size to measure its PSNR.
-fn finish(mesh: GradientMesh, image: &RgbaImage, rounds: usize) -> Result<Vectorised, Error> {
+fn finish(mut mesh: GradientMesh, image: &RgbaImage, rounds: usize) -> Result<Vectorised, Error> {
+    // Two decimals (a hundredth of a pixel, of a Lab unit) are far below what the picture
+    // shows, and keep the file small.
+    let round = |v: f64| (v * 100.0).round() / 100.0;
+    for p in &mut mesh.points {
+        p.position = kurbo::Point::new(round(p.position.x), round(p.position.y));
+        p.colour = p.colour.map(round);
+    }
     let points = mesh.points.len();
     let document = Document { layers: vec![mesh] };
     let view = View::new(0.0, 0.0, image.width as f64, image.height as f64);

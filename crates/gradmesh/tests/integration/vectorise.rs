@@ -245,3 +245,72 @@ fn bad_options_are_refused() {
     let empty = RgbaImage::filled(0, 10, [0.0; 4]);
     assert!(vectorise(&empty, &VectoriseOptions::default()).is_err());
 }
+
+/// A picture of two colours split by a slanted line that no cell side follows.
+fn slanted_edge(w: u32, h: u32) -> RgbaImage {
+    let pixels = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
+            if x + 0.3 * y < 0.45 * w as f64 {
+                [0.85, 0.55, 0.2, 1.0]
+            } else {
+                [0.15, 0.25, 0.6, 1.0]
+            }
+        })
+        .collect();
+    RgbaImage {
+        width: w,
+        height: h,
+        pixels,
+    }
+}
+
+/// Moving the points cuts the error where the picture has an edge between cell corners; the
+/// moved mesh has no fold, covers the picture, keeps the points on its sides on them and its
+/// corners at the picture's.
+#[test]
+fn moving_points_follows_an_edge() {
+    let image = slanted_edge(96, 64);
+    let run = |fit_positions: bool| {
+        let options = VectoriseOptions {
+            points: Some(60),
+            fit_positions,
+            ..VectoriseOptions::default()
+        };
+        vectorise(&image, &options).unwrap()
+    };
+    let (fixed, moved) = (run(false), run(true));
+    assert!(
+        moved.psnr > fixed.psnr + 2.0,
+        "moved {} dB, fixed {} dB",
+        moved.psnr,
+        fixed.psnr
+    );
+    let mesh = &moved.document.layers[0];
+    let fixed_mesh = &fixed.document.layers[0];
+    assert_eq!(mesh.points.len(), fixed_mesh.points.len());
+    let shifted = mesh
+        .points
+        .iter()
+        .zip(&fixed_mesh.points)
+        .filter(|(a, b)| a.position.distance(b.position) > 0.1)
+        .count();
+    assert!(shifted > 0, "no point moved");
+    assert!(gradmesh::render::find_folds(mesh).unwrap().is_empty());
+    for p in &mesh.points {
+        let q = p.position;
+        assert!(
+            (0.0..=96.0).contains(&q.x) && (0.0..=64.0).contains(&q.y),
+            "{q:?}"
+        );
+    }
+    for corner in [(0.0, 0.0), (96.0, 0.0), (96.0, 64.0), (0.0, 64.0)] {
+        let corner = Point::new(corner.0, corner.1);
+        assert!(
+            mesh.points.iter().any(|p| p.position == corner),
+            "{corner:?}"
+        );
+    }
+    let back = render(&moved.document, 96, 64);
+    assert!(back.pixels.iter().all(|p| p[3] > 0.99));
+}
