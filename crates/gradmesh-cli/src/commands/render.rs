@@ -154,7 +154,13 @@ pub fn run(args: &RenderArgs, report: &mut WarningReport) -> Result<(), Error> {
         // give a size or a view.
         let sized_by_flags = args.width.is_some() || args.height.is_some() || args.view.is_some();
         let page_px = viewport.filter(|_| !sized_by_flags).map(|(_, size)| size);
-        let output = VectorOutput { pdf, page_px };
+        let svg_mesh: SvgMeshRendering = args.svg_mesh.into();
+        let classic = (pdf && svg_mesh == SvgMeshRendering::Classic).then_some(fills.as_slice());
+        let output = VectorOutput {
+            pdf,
+            page_px,
+            classic,
+        };
         return vector(args, &doc, &opts, output, &origins, read, report).map_err(locate);
     }
     // The image's size and view are checked before its buffer is allocated.
@@ -343,10 +349,12 @@ fn draw<P: render::OutputPixel>(
 }
 
 /// What vector output is written: a PDF (`pdf`) or an SVG, with the page's size in CSS
-/// pixels when it is not the render's.
-struct VectorOutput {
+/// pixels when it is not the render's, and the fills of the layers that an SVG file's meshes
+/// were converted from, when they are written as they are.
+struct VectorOutput<'a> {
     pdf: bool,
     page_px: Option<(f64, f64)>,
+    classic: Option<&'a [Option<super::ClassicFill>]>,
 }
 
 /// Writes the document as a PDF or an SVG, with the page and view of `render`.
@@ -354,7 +362,11 @@ fn vector(
     args: &RenderArgs,
     doc: &Document,
     render: &RenderOptions,
-    VectorOutput { pdf, page_px }: VectorOutput,
+    VectorOutput {
+        pdf,
+        page_px,
+        classic,
+    }: VectorOutput,
     origins: &[(&std::path::Path, usize)],
     read: std::time::Duration,
     report: &mut WarningReport,
@@ -368,7 +380,7 @@ fn vector(
     opts.limits = args.limits.limits();
     let start = Instant::now();
     let (bytes, info) = if pdf {
-        export::write_pdf(doc, &opts)?
+        export::write_pdf_picture(&export_layers(doc, classic), &opts)?
     } else {
         export::write_svg(doc, &opts, !args.no_fallback)?
     };
@@ -397,6 +409,22 @@ fn vector(
         );
     }
     Ok(())
+}
+
+/// The layers of `doc` to export: a layer converted from an SVG mesh gradient as the
+/// gradient's own patches when `classic` holds the fills, otherwise the scheme's.
+fn export_layers<'a>(
+    doc: &'a Document,
+    classic: Option<&'a [Option<super::ClassicFill>]>,
+) -> Vec<export::ExportLayer<'a>> {
+    doc.layers
+        .iter()
+        .enumerate()
+        .map(|(i, mesh)| match classic.and_then(|f| f[i].as_ref()) {
+            Some(super::ClassicFill::Svg(fill)) => export::ExportLayer::SvgMesh(fill),
+            _ => export::ExportLayer::Scheme(mesh),
+        })
+        .collect()
 }
 
 /// Warns of the flags given that only PNG output uses.

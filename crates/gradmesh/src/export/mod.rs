@@ -30,6 +30,7 @@
 //! ```
 
 mod bezier;
+mod classic;
 mod pdf;
 mod split;
 mod surface;
@@ -40,7 +41,8 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::error::{Error, ErrorKind, Warning};
-use crate::mesh::Document;
+use crate::formats::svg::{FillRule, MeshFill};
+use crate::mesh::{Document, GradientMesh};
 use crate::size_limits::Limits;
 use crate::view::{check_image, ToPixels, MAX_PIXELS};
 
@@ -48,8 +50,26 @@ use split::{OutPatch, Splitter, Target};
 use surface::{layer_surface, Curve, SurfaceOptions};
 
 pub use crate::view::View;
-pub use pdf::{write_pdf, POINTS_PER_PIXEL};
+pub use pdf::{write_pdf, write_pdf_picture, POINTS_PER_PIXEL};
 pub use svg::write_svg;
+
+/// One layer of a picture to export, bottom first.
+#[derive(Clone, Copy, Debug)]
+pub enum ExportLayer<'a> {
+    /// A mesh of the scheme: its limit surface, clipped to its outline.
+    Scheme(&'a GradientMesh),
+    /// An SVG mesh gradient's patches as they are (not converted into the scheme), clipped to
+    /// its shape: Coons patches with colour bilinear in sRGB, a `type="bicubic"` patch cut
+    /// into the cells of its smoothed colours.
+    SvgMesh(&'a MeshFill),
+}
+
+impl<'a> ExportLayer<'a> {
+    /// The layers of `doc`, each of the scheme.
+    pub fn of_document(doc: &'a Document) -> Vec<ExportLayer<'a>> {
+        doc.layers.iter().map(ExportLayer::Scheme).collect()
+    }
+}
 
 /// The default colour tolerance, in ΔE00 ([`ExportOptions::tolerance`]).
 pub const DEFAULT_TOLERANCE: f64 = 0.5;
@@ -186,21 +206,25 @@ pub(crate) struct SplitGrid {
     pub m: usize,
 }
 
-/// One layer's output: its patches, how they were split, its outline and whether it needs a
+/// One layer's output: its patches, how they were split, its outline (and the rule that tells
+/// its inside), the space of its colours when it is not the export's, and whether it needs a
 /// soft mask.
 pub(crate) struct LayerPatches {
     pub patches: Vec<OutPatch>,
     pub grids: Vec<SplitGrid>,
     pub outline: Vec<Vec<Curve>>,
+    pub clip_rule: FillRule,
+    pub colour: Option<Target>,
     pub masked: bool,
     pub approximated: usize,
     pub geometry_error: f64,
     pub warnings: Vec<Warning>,
 }
 
-/// Every layer of `doc` as split patches in `target`'s space, with what was done so far.
+/// Every layer of `layers` as patches, those of the scheme split in `target`'s space, with
+/// what was done so far.
 pub(crate) fn layer_patches(
-    doc: &Document,
+    layers: &[ExportLayer],
     opts: &ExportOptions,
     target: Target,
 ) -> Result<(Vec<LayerPatches>, ExportInfo), Error> {
@@ -214,11 +238,16 @@ pub(crate) fn layer_patches(
         colour_tolerance: opts.tolerance,
         limits: opts.limits.clone(),
     };
-    let layers: Vec<Option<LayerPatches>> = doc
-        .layers
+    let layers: Vec<Option<LayerPatches>> = layers
         .par_iter()
         .enumerate()
-        .map(|(index, mesh)| -> Result<Option<LayerPatches>, Error> {
+        .map(|(index, layer)| -> Result<Option<LayerPatches>, Error> {
+            let mesh = match layer {
+                ExportLayer::Scheme(mesh) => mesh,
+                ExportLayer::SvgMesh(fill) => {
+                    return Ok(Some(classic::svg_fill_patches(fill, &surface_opts.xf)));
+                }
+            };
             let Some(surface) = layer_surface(mesh, index, &surface_opts)? else {
                 return Ok(None);
             };
@@ -249,6 +278,8 @@ pub(crate) fn layer_patches(
                 patches,
                 grids,
                 outline: surface.outline,
+                clip_rule: FillRule::NonZero,
+                colour: None,
                 masked: !surface.opaque,
                 approximated: surface.approximated,
                 geometry_error: surface.geometry_error,

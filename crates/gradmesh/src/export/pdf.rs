@@ -12,8 +12,9 @@ use pdf_writer::{Content, Filter, Finish, Name, Pdf, Rect, Ref};
 
 use super::split::{OutPatch, Target};
 use super::surface::Curve;
-use super::{layer_patches, ExportInfo, ExportOptions, LayerPatches, PdfColour};
+use super::{layer_patches, ExportInfo, ExportLayer, ExportOptions, LayerPatches, PdfColour};
 use crate::error::{Error, ErrorKind};
+use crate::formats::svg::FillRule;
 use crate::mesh::Document;
 
 /// The D65 white point, with Y = 1 as the format asks.
@@ -51,11 +52,21 @@ pub const POINTS_PER_PIXEL: f64 = 0.75;
 /// points to 96 CSS pixels (a 96 dpi rasterisation has the size of a render of the same
 /// options), and what was written.
 pub fn write_pdf(doc: &Document, opts: &ExportOptions) -> Result<(Vec<u8>, ExportInfo), Error> {
+    write_pdf_picture(&ExportLayer::of_document(doc), opts)
+}
+
+/// [`write_pdf`] of a picture whose layers may be SVG mesh gradients written as they are
+/// ([`ExportLayer::SvgMesh`]: their shadings in DeviceRGB, whatever [`ExportOptions::colour`]
+/// says, since their colours are bilinear in sRGB).
+pub fn write_pdf_picture(
+    layers: &[ExportLayer],
+    opts: &ExportOptions,
+) -> Result<(Vec<u8>, ExportInfo), Error> {
     let target = match opts.colour {
         PdfColour::Lab => Target::Lab,
         PdfColour::Srgb => Target::Srgb,
     };
-    let (layers, mut info) = layer_patches(doc, opts, target)?;
+    let (layers, mut info) = layer_patches(layers, opts, target)?;
     let start = std::time::Instant::now();
     let bytes = pdf_bytes(&layers, opts, target)?;
     info.seconds += start.elapsed().as_secs_f64();
@@ -109,7 +120,7 @@ fn pdf_bytes(
             &mut pdf,
             shading,
             &layer.patches,
-            ShadingKind::Colour(target),
+            ShadingKind::Colour(layer.colour.unwrap_or(target)),
         )?;
         shadings.push((colour_name.clone(), shading));
         content.save_state();
@@ -143,7 +154,7 @@ fn pdf_bytes(
             content.set_parameters(Name(state_name.as_bytes()));
             states.push((state_name, state));
         }
-        clip_to(&mut content, &layer.outline);
+        clip_to(&mut content, &layer.outline, layer.clip_rule);
         content.shading(Name(colour_name.as_bytes()));
         content.restore_state();
     }
@@ -169,8 +180,9 @@ fn pdf_bytes(
     Ok(pdf.finish())
 }
 
-/// Sets the clip to the loops of `outline` (nonzero winding: holes run the other way).
-fn clip_to(content: &mut Content, outline: &[Vec<Curve>]) {
+/// Sets the clip to the loops of `outline`, inside by `rule` (a layer's own outline is
+/// nonzero: its holes run the other way).
+fn clip_to(content: &mut Content, outline: &[Vec<Curve>], rule: FillRule) {
     for curves in outline {
         let Some(first) = curves.first() else {
             continue;
@@ -188,7 +200,10 @@ fn clip_to(content: &mut Content, outline: &[Vec<Curve>]) {
         }
         content.close_path();
     }
-    content.clip_nonzero();
+    match rule {
+        FillRule::NonZero => content.clip_nonzero(),
+        FillRule::EvenOdd => content.clip_even_odd(),
+    };
     content.end_path();
 }
 

@@ -22,7 +22,7 @@ use std::fmt::Write as _;
 
 use super::split::{OutPatch, Target};
 use super::surface::Curve;
-use super::{layer_patches, ExportInfo, ExportOptions, LayerPatches};
+use super::{layer_patches, ExportInfo, ExportLayer, ExportOptions, LayerPatches};
 use crate::error::Error;
 use crate::mesh::Document;
 use crate::render::{encode_png, render_image, PngDepth, RenderOptions};
@@ -44,7 +44,7 @@ pub fn write_svg(
     opts: &ExportOptions,
     fallback: bool,
 ) -> Result<(Vec<u8>, ExportInfo), Error> {
-    let (layers, mut info) = layer_patches(doc, opts, Target::Srgb)?;
+    let (layers, mut info) = layer_patches(&ExportLayer::of_document(doc), opts, Target::Srgb)?;
     let start = std::time::Instant::now();
     let (w, h) = (opts.width, opts.height);
     let (page_w, page_h) = opts.page_size_px();

@@ -20,6 +20,7 @@ use lopdf::{Dictionary, Document as LoDocument, LoadOptions, Object, ObjectId};
 
 pub use colour::{Function, PdfColourSpace, ShadingColour};
 pub use convert::{fill_to_layer, picture_to_document};
+pub(crate) use scene::coons_interior;
 pub use scene::{Patch, PdfPicture, ShadingFill};
 
 use crate::colour::ColourSpace;

@@ -32,6 +32,7 @@ mod convert;
 mod gradient;
 mod lines;
 mod mask;
+pub(crate) mod paint;
 mod read;
 mod scene;
 mod shape;
