@@ -87,7 +87,7 @@ fn fit_colours_recovers_a_rendered_mesh() {
 }
 
 /// Round trip: a known mesh rendered to a picture, vectorised with at most twice its points,
-/// renders back close to the picture.
+/// renders back above 40 dB.
 #[test]
 fn a_rendered_mesh_vectorises_back() {
     let mesh = grid_mesh();
@@ -98,7 +98,7 @@ fn a_rendered_mesh_vectorises_back() {
     };
     let v = vectorise(&image, &options).unwrap();
     assert!(v.points <= 40);
-    assert!(v.psnr > 36.0, "{} dB with {} points", v.psnr, v.points);
+    assert!(v.psnr > 40.0, "{} dB with {} points", v.psnr, v.points);
     // The document covers the picture: its render at the picture's size has no hole.
     let back = render(&v.document, 120, 90);
     assert!(back.pixels.iter().all(|p| p[3] > 0.99));
