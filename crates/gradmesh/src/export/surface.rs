@@ -30,6 +30,11 @@ const MAX_LOCAL_DEPTH: usize = 8;
 /// Levels deeper than this are not taken to let semi-sharpness on the outline decay.
 const DEEPEST_LEVEL: usize = 6;
 
+/// Opacities from this up count as 1: refining a layer whose opacity is 1 everywhere leaves
+/// values a few rounding steps below 1 (sums of stencil weights), which are no translucency
+/// and would give the layer a mask of no effect.
+const OPAQUE: f64 = 1.0 - 1e-9;
+
 /// A cubic Bézier curve in pixels.
 pub(crate) type Curve = [[f64; 2]; 4];
 
@@ -41,7 +46,7 @@ pub(crate) struct LayerSurface {
     pub nets: Vec<BezierNet>,
     /// The boundary loops as Bézier curves, in pixels.
     pub outline: Vec<Vec<Curve>>,
-    /// Whether every opacity is 1.
+    /// Whether every opacity is 1 (at least [`OPAQUE`]).
     pub opaque: bool,
     /// Flat patches standing for irregular descendants.
     pub approximated: usize,
@@ -97,7 +102,7 @@ pub(crate) fn layer_surface(
         space: mesh.colour_space,
         nets: Vec::new(),
         outline: outline_curves(level, &px),
-        opaque: px.iter().all(|d| d[5] >= 1.0),
+        opaque: px.iter().all(|d| d[5] >= OPAQUE),
         approximated: 0,
         geometry_error: 0.0,
         warnings: warnings

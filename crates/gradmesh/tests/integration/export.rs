@@ -629,6 +629,39 @@ fn translucent_svg_matches_the_render_in_inkscape_and_chromium() {
     }
 }
 
+/// An opaque mesh (opacity 1 at every point, a little below after refinement's rounding)
+/// needs no mask.
+#[test]
+fn opaque_layers_get_no_mask() {
+    let real = |files: &[String]| {
+        let mut doc = Document::default();
+        for f in files {
+            let path = super::realdata::path(f);
+            doc.layers.extend(formats::read_path(&path).unwrap().layers);
+        }
+        doc
+    };
+    let tucan: Vec<String> = (0..=5)
+        .rev()
+        .map(|k| format!("Tucan_Tucan_Layer{k}.off"))
+        .collect();
+    for (name, doc) in [
+        ("handles-short", example("handles-short.json")),
+        ("non-rectangular", example("non-rectangular.json")),
+        ("sparse-irregular", example("sparse-irregular.json")),
+        ("Glasses", real(&["Glasses.off".to_string()])),
+        ("Tucan", real(&tucan)),
+    ] {
+        let render = RenderOptions::fit(&doc, 128);
+        let opts = ExportOptions::new(render.width, render.height, render.view);
+        let (_, info) = write_pdf(&doc, &opts).unwrap();
+        assert_eq!(info.masked_layers, 0, "{name}");
+        let (svg, info) = write_svg(&doc, &opts, false).unwrap();
+        assert_eq!(info.masked_layers, 0, "{name}");
+        assert!(!String::from_utf8(svg).unwrap().contains("<mask"), "{name}");
+    }
+}
+
 #[test]
 fn svg_fallback_is_a_png_hidden_where_meshes_are_drawn() {
     let doc = translucent_document();
