@@ -412,8 +412,8 @@ pub struct RenderArgs {
     /// How the mesh gradients of SVG inputs and the patch-mesh shadings of PDF inputs are
     /// drawn, each clipped to its shape: `classic` as Inkscape paints them and as the PDF
     /// specification defines them, `scheme` converted into the scheme (the layers `convert`
-    /// writes). PDF output of an SVG input with `classic` writes the meshes' own patches as PDF
-    /// patches; SVG output, and PDF output of a PDF input, take the scheme.
+    /// writes). PDF and SVG output of an SVG input with `classic` write the meshes' own patches;
+    /// those of a PDF input take the scheme.
     #[arg(long, value_name = "MODE", default_value = "classic")]
     pub svg_mesh: SvgMeshArg,
     /// Slow and simple reference rendering (for checking the fast path).

@@ -155,7 +155,7 @@ pub fn run(args: &RenderArgs, report: &mut WarningReport) -> Result<(), Error> {
         let sized_by_flags = args.width.is_some() || args.height.is_some() || args.view.is_some();
         let page_px = viewport.filter(|_| !sized_by_flags).map(|(_, size)| size);
         let svg_mesh: SvgMeshRendering = args.svg_mesh.into();
-        let classic = (pdf && svg_mesh == SvgMeshRendering::Classic).then_some(fills.as_slice());
+        let classic = (svg_mesh == SvgMeshRendering::Classic).then_some(fills.as_slice());
         let output = VectorOutput {
             pdf,
             page_px,
@@ -382,7 +382,7 @@ fn vector(
     let (bytes, info) = if pdf {
         export::write_pdf_picture(&export_layers(doc, classic), &opts)?
     } else {
-        export::write_svg(doc, &opts, !args.no_fallback)?
+        export::write_svg_picture(&export_layers(doc, classic), &opts, !args.no_fallback)?
     };
     let made = start.elapsed();
     add_warnings(report, info.warnings, origins);

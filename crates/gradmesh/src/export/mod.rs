@@ -51,7 +51,7 @@ use surface::{layer_surface, Curve, SurfaceOptions};
 
 pub use crate::view::View;
 pub use pdf::{write_pdf, write_pdf_picture, POINTS_PER_PIXEL};
-pub use svg::write_svg;
+pub use svg::{write_svg, write_svg_picture};
 
 /// One layer of a picture to export, bottom first.
 #[derive(Clone, Copy, Debug)]

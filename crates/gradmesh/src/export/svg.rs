@@ -24,8 +24,11 @@ use super::split::{OutPatch, Target};
 use super::surface::Curve;
 use super::{layer_patches, ExportInfo, ExportLayer, ExportOptions, LayerPatches};
 use crate::error::Error;
+use crate::formats::svg::FillRule;
 use crate::mesh::Document;
-use crate::render::{encode_png, render_image, PngDepth, RenderOptions};
+use crate::render::{
+    encode_png, render_picture_into, Image, LayerSource, PictureLayer, PngDepth, RenderOptions,
+};
 
 /// What a mesh gradient paints: a layer's colours, or its opacity as grey (in the layer's
 /// luminance mask).
@@ -44,7 +47,22 @@ pub fn write_svg(
     opts: &ExportOptions,
     fallback: bool,
 ) -> Result<(Vec<u8>, ExportInfo), Error> {
-    let (layers, mut info) = layer_patches(&ExportLayer::of_document(doc), opts, Target::Srgb)?;
+    write_svg_picture(&ExportLayer::of_document(doc), opts, fallback)
+}
+
+/// [`write_svg`] of a picture whose layers may be SVG mesh gradients written as they are
+/// ([`ExportLayer::SvgMesh`]: each patch a mesh patch of the same sides and corner colours,
+/// oriented as in the source; a `type="bicubic"` one as the cells of its smoothed colours), the
+/// fallback drawn by the renderer's classic painting of them.
+pub fn write_svg_picture(
+    picture: &[ExportLayer],
+    opts: &ExportOptions,
+    fallback: bool,
+) -> Result<(Vec<u8>, ExportInfo), Error> {
+    let (mut layers, mut info) = layer_patches(picture, opts, Target::Srgb)?;
+    for layer in layers.iter_mut().filter(|l| l.colour.is_some()) {
+        transpose(layer);
+    }
     let start = std::time::Instant::now();
     let (w, h) = (opts.width, opts.height);
     let (page_w, page_h) = opts.page_size_px();
@@ -54,7 +72,7 @@ pub fn write_svg(
         r#"<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" width="{page_w}" height="{page_h}" viewBox="0 0 {w} {h}">"#
     );
     if fallback {
-        write_fallback(&mut out, doc, opts)?;
+        write_fallback(&mut out, picture, opts)?;
     }
     let mut mesh_id = 0usize;
     for (k, layer) in layers.iter().enumerate() {
@@ -67,6 +85,21 @@ pub fn write_svg(
     Ok((out.into_bytes(), info))
 }
 
+/// Swaps the parameters of every patch of `layer`: the patches of an SVG mesh gradient
+/// ([`super::classic`]) run `u` down the grid, as PDF's painting order wants, and the mesh
+/// gradients written here run `u` along the rows. Their cells stay in order: row by row down
+/// the grid.
+fn transpose(layer: &mut LayerPatches) {
+    for cell in &mut layer.patches {
+        let corners = [0, 3, 2, 1];
+        *cell = OutPatch {
+            points: std::array::from_fn(|j| std::array::from_fn(|i| cell.points[i][j])),
+            colours: corners.map(|c| cell.colours[c]),
+            opacity: corners.map(|c| cell.opacity[c]),
+        };
+    }
+}
+
 /// The page grown by a pixel on every side, as a mask's region: the edges of what a mask
 /// holds then lie outside the page.
 fn page_region((w, h): (u32, u32)) -> String {
@@ -75,9 +108,29 @@ fn page_region((w, h): (u32, u32)) -> String {
 
 /// The PNG of the render, masked so that viewers that draw mesh gradients hide it (see the
 /// module's notes).
-fn write_fallback(out: &mut String, doc: &Document, opts: &ExportOptions) -> Result<(), Error> {
+fn write_fallback(
+    out: &mut String,
+    picture: &[ExportLayer],
+    opts: &ExportOptions,
+) -> Result<(), Error> {
     let (w, h) = (opts.width, opts.height);
-    let (image, _) = render_image(doc, &RenderOptions::new(w, h, opts.view))?;
+    let layers: Vec<PictureLayer> = picture
+        .iter()
+        .map(|layer| match *layer {
+            ExportLayer::Scheme(mesh) => PictureLayer {
+                source: LayerSource::Scheme(mesh),
+                clip: None,
+            },
+            ExportLayer::SvgMesh(fill) => PictureLayer {
+                source: LayerSource::Classic(fill),
+                clip: Some((&fill.clip, fill.fill_rule)),
+            },
+        })
+        .collect();
+    let render_opts = RenderOptions::new(w, h, opts.view);
+    render_opts.check()?;
+    let mut image = Image::new(w, h);
+    render_picture_into(&layers, &render_opts, &mut image.data)?;
     let png = encode_png(&image, PngDepth::Eight { dither: true })?;
     let (bw, bh) = (w + 2, h + 2);
     let black = r##"stop-color="#000000""##;
@@ -110,7 +163,11 @@ fn write_layer(
 ) {
     let _ = writeln!(
         out,
-        r#"<clipPath id="outline{k}"><path clip-rule="nonzero" d="{}"/></clipPath>"#,
+        r#"<clipPath id="outline{k}"><path clip-rule="{}" d="{}"/></clipPath>"#,
+        match layer.clip_rule {
+            FillRule::NonZero => "nonzero",
+            FillRule::EvenOdd => "evenodd",
+        },
         outline_path(&layer.outline)
     );
     if layer.masked {
