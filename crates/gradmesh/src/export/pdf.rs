@@ -14,6 +14,7 @@ use super::split::{OutPatch, Target};
 use super::surface::Curve;
 use super::{layer_patches, ExportInfo, ExportLayer, ExportOptions, LayerPatches, PdfColour};
 use crate::error::{Error, ErrorKind};
+use crate::formats::pdf::POINT_ORDER;
 use crate::formats::svg::FillRule;
 use crate::mesh::Document;
 
@@ -22,25 +23,6 @@ const D65: [f32; 3] = [0.9505, 1.0, 1.089];
 /// The a* and b* range of the Lab space: the sRGB gamut reaches b* = -107.9, beyond the
 /// default range of ±100.
 const LAB_RANGE: [f32; 4] = [-128.0, 127.0, -128.0, 127.0];
-/// The stream order of the 16 points `p_ij` (`i` along `u`) of a type 7 patch record.
-const STREAM_ORDER: [(usize, usize); 16] = [
-    (0, 0),
-    (0, 1),
-    (0, 2),
-    (0, 3),
-    (1, 3),
-    (2, 3),
-    (3, 3),
-    (3, 2),
-    (3, 1),
-    (3, 0),
-    (2, 0),
-    (1, 0),
-    (1, 1),
-    (1, 2),
-    (2, 2),
-    (2, 1),
-];
 /// The corners of a record's colours (c00, c03, c33, c30) among [`OutPatch`]'s corners
 /// (`(0, 0)`, `(1, 0)`, `(1, 1)`, `(0, 1)` in `(u, v)`).
 const CORNER_ORDER: [usize; 4] = [0, 3, 2, 1];
@@ -313,7 +295,7 @@ fn records(
     };
     for p in patches {
         data.push(0);
-        for &(i, j) in &STREAM_ORDER {
+        for &(i, j) in &POINT_ORDER {
             let point = p.points[j][i];
             for k in 0..2 {
                 let q = quantise(point[k], lo[k], hi[k], coordinate_max);

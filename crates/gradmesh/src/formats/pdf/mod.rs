@@ -22,6 +22,7 @@ pub use colour::{Function, PdfColourSpace, ShadingColour};
 pub use convert::{fill_to_layer, picture_to_document};
 pub(crate) use scene::coons_interior;
 pub use scene::{Patch, PdfPicture, ShadingFill};
+pub(crate) use shading::POINT_ORDER;
 
 use crate::colour::ColourSpace;
 use crate::error::{Error, Warning};

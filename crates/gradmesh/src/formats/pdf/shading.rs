@@ -444,8 +444,9 @@ impl<'a> BitReader<'a> {
     }
 }
 
-/// The stream positions of the points of a record with flag 0: `(i, j)` of `p[i][j]`.
-const POINT_ORDER: [(usize, usize); 16] = [
+/// The stream positions of the points of a type 7 record with flag 0: `(i, j)` of `p[i][j]`,
+/// `i` along `u` (the writer's order too).
+pub(crate) const POINT_ORDER: [(usize, usize); 16] = [
     (0, 0),
     (0, 1),
     (0, 2),
