@@ -320,3 +320,74 @@ fn pdf_pages_have_inkscapes_size() {
     assert!((numbers[2] - 367.0).abs() < 0.01, "{numbers:?}");
     assert!((numbers[3] - 693.174).abs() < 0.01, "{numbers:?}");
 }
+
+/// The mesh fill `scripts/resvg-suite.sh` adds to every file: a 1x1 patch far off the canvas.
+const PROBE: &str = concat!(
+    "<defs><meshgradient id=\"gm_probe_mesh\" x=\"-100000\" y=\"-100000\" ",
+    "gradientUnits=\"userSpaceOnUse\"><meshrow><meshpatch>",
+    "<stop path=\"l 1,0\" stop-color=\"#f00\"/><stop path=\"l 0,1\" stop-color=\"#f00\"/>",
+    "<stop path=\"l -1,0\" stop-color=\"#f00\"/><stop path=\"l 0,-1\" stop-color=\"#f00\"/>",
+    "</meshpatch></meshrow></meshgradient></defs>",
+    "<rect x=\"-100000\" y=\"-100000\" width=\"1\" height=\"1\" fill=\"url(#gm_probe_mesh)\"/>"
+);
+
+/// How many pixels differ by more than one level in a channel (resvg's suite's test), leaving
+/// out pixels clear in both.
+fn pixels_off_reference(actual: &[u8], reference: &Path) -> usize {
+    let (_, _, expected) = decode_png(reference);
+    assert_eq!(actual.len(), expected.len(), "{}", reference.display());
+    actual
+        .chunks_exact(4)
+        .zip(expected.chunks_exact(4))
+        .filter(|(p, q)| !(p[3] == 0 && q[3] == 0) && (0..4).any(|c| p[c].abs_diff(q[c]) > 1))
+        .count()
+}
+
+/// Six tests of resvg's own suite (`tests/data/resvg-suite/`, its README says which), with a
+/// mesh fill added off the canvas, are drawn through the whole-picture path as resvg's
+/// reference PNGs show them: every pixel within one level.
+#[test]
+fn resvg_suite_samples_match_their_references() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/resvg-suite");
+    let mut names: Vec<PathBuf> = std::fs::read_dir(&data)
+        .unwrap_or_else(|e| panic!("{}: {e}", data.display()))
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "svg"))
+        .collect();
+    names.sort();
+    assert_eq!(names.len(), 6, "the six SVG files of {}", data.display());
+    let dir = tempfile::tempdir().unwrap();
+    for svg in &names {
+        let text = std::fs::read_to_string(svg).unwrap();
+        let close = text.rfind("</svg>").expect("a closing </svg>");
+        let injected = format!("{}{PROBE}{}", &text[..close], &text[close..]);
+        let input = dir.path().join("in.svg");
+        std::fs::write(&input, injected).unwrap();
+        let reference = svg.with_extension("png");
+        let (w, h, _) = decode_png(&reference);
+        let (w, h) = (w.to_string(), h.to_string());
+        let args = [
+            "render",
+            "in.svg",
+            "-o",
+            "out.png",
+            "--force",
+            "--width",
+            &w,
+            "--height",
+            &h,
+            "--no-dither",
+        ];
+        let out = gradmesh_in(dir.path(), &args);
+        let name = svg.file_name().unwrap().to_string_lossy();
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        assert!(
+            !stderr(&out).contains("only the mesh fills"),
+            "{name}: {}",
+            stderr(&out)
+        );
+        let (_, _, actual) = decode_png(&dir.path().join("out.png"));
+        let off = pixels_off_reference(&actual, &reference);
+        assert_eq!(off, 0, "{name}: {off} pixels differ from resvg's reference");
+    }
+}
