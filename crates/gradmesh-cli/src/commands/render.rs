@@ -176,7 +176,8 @@ pub fn run(args: &RenderArgs, report: &mut WarningReport) -> Result<(), Error> {
             let path = &args.inputs[0];
             let text = std::fs::read_to_string(path)
                 .map_err(|e| Error::new(ErrorKind::Io(format!("{}: {e}", path.display()))))?;
-            let drawn = whole_svg_picture((path, &text), layers, &opts, args.max_memory)
+            let sixteen = args.bits == 16;
+            let drawn = whole_svg_picture((path, &text), layers, &opts, (args.max_memory, sixteen))
                 .map_err(|e| locate(e).in_file(path))?;
             report.add(Some(path), left_out_of(&mut left_out[0].1, drawn.is_ok()));
             if let Err(message) = &drawn {
@@ -189,11 +190,15 @@ pub fn run(args: &RenderArgs, report: &mut WarningReport) -> Result<(), Error> {
         }
         _ => None,
     };
-    let (pixels, info) = if let Some((mut image, info)) = whole_picture {
-        if args.boundary {
+    let (pixels, info) = if let Some((picture, info)) = whole_picture {
+        let pixels = whole_picture_pixels(picture);
+        if !args.boundary {
+            (pixels, info)
+        } else {
+            let mut image = pixels.into_float(&opts);
             render::draw_outlines(&doc, &opts, &mut image).map_err(locate)?;
+            (Pixels::Float(image), info)
         }
-        (Pixels::Float(image), info)
     } else if args.boundary {
         let mut image = render::Image::new(opts.width, opts.height);
         let info = draw(&doc, picture, &opts, &mut image.data).map_err(locate)?;
@@ -314,10 +319,21 @@ fn whole_svg_picture(
     file: (&std::path::Path, &str),
     layers: &[PictureLayer<'_>],
     opts: &RenderOptions,
-    max_memory: Option<u64>,
-) -> Result<Result<(render::Image, render::RenderInfo), String>, Error> {
+    (max_memory, sixteen): (Option<u64>, bool),
+) -> Result<Result<(WholePicture, render::RenderInfo), String>, Error> {
     let max_memory = max_memory.unwrap_or_else(machine_memory);
-    super::whole_picture::render_whole_picture(file, layers, opts, max_memory)
+    super::whole_picture::render_whole_picture(file, layers, opts, (max_memory, sixteen))
+}
+
+#[cfg(feature = "svg-whole-picture")]
+use super::whole_picture::WholePicture;
+
+/// What the whole picture would be drawn as (never made without resvg).
+#[cfg(not(feature = "svg-whole-picture"))]
+#[allow(dead_code)]
+enum WholePicture {
+    Eight(Vec<u8>),
+    Sixteen(Vec<u16>),
 }
 
 /// Without resvg, only the mesh fills of an SVG file are drawn.
@@ -326,8 +342,8 @@ fn whole_svg_picture(
     _file: (&std::path::Path, &str),
     _layers: &[PictureLayer<'_>],
     _opts: &RenderOptions,
-    _max_memory: Option<u64>,
-) -> Result<Result<(render::Image, render::RenderInfo), String>, Error> {
+    _max_memory: (Option<u64>, bool),
+) -> Result<Result<(WholePicture, render::RenderInfo), String>, Error> {
     Ok(Err(
         "this gradmesh was built without resvg, which draws the rest (cargo feature \
          `svg-whole-picture`, on by default)"
@@ -497,4 +513,27 @@ enum Pixels {
     Float(render::Image),
     Sixteen(Vec<u16>),
     Eight(Vec<u8>),
+}
+
+fn whole_picture_pixels(picture: WholePicture) -> Pixels {
+    match picture {
+        WholePicture::Eight(data) => Pixels::Eight(data),
+        WholePicture::Sixteen(data) => Pixels::Sixteen(data),
+    }
+}
+
+impl Pixels {
+    /// The picture as an `f32` image of `opts`'s size (to draw outlines on).
+    fn into_float(self, opts: &RenderOptions) -> render::Image {
+        let data = match self {
+            Pixels::Float(image) => return image,
+            Pixels::Sixteen(data) => data.iter().map(|&v| f32::from(v) / 65535.0).collect(),
+            Pixels::Eight(data) => data.iter().map(|&v| f32::from(v) / 255.0).collect(),
+        };
+        render::Image {
+            width: opts.width,
+            height: opts.height,
+            data,
+        }
+    }
 }

@@ -6,8 +6,10 @@
 //! rendered by resvg from a copy of the text in which every drawn element outside the segment
 //! has `display:none`, and whose root shows the render's view at the render's size. A mesh
 //! shape's stroke is drawn at the start of the segment above its fill (its fill set to `none`).
-//! Segments and mesh layers are composited source-over with premultiplied alpha, in `f32`, on
-//! sRGB-encoded values (as resvg and Inkscape blend). A segment that draws nothing (no element
+//! Everything is drawn into one premultiplied canvas ([`Canvas`]): resvg draws each segment
+//! into it (at 16 bits, through one reused 8-bit pixmap) and the mesh layers are composited
+//! into it band by band, source-over on sRGB-encoded values (as resvg and Inkscape blend). A
+//! segment that draws nothing (no element
 //! but mesh shapes, and no stroke on the mesh shape it starts at) is not rendered, and the mesh
 //! layers it separates are rendered together: a file of thousands of mesh-filled shapes and
 //! nothing else (gradmesh's own SVG export) costs one mesh render. Each segment that draws is
@@ -21,7 +23,7 @@ use std::collections::HashSet;
 use std::ops::Range;
 use std::path::Path;
 
-use gradmesh::render::{self, Image, PictureLayer, RenderOptions};
+use gradmesh::render::{self, PictureLayer, RenderOptions};
 use gradmesh::{Error, ErrorKind};
 use roxmltree::{Document, Node};
 
@@ -311,10 +313,16 @@ impl<'a, 'input> Segments<'a, 'input> {
     }
 }
 
-/// The whole picture's memory, in bytes per pixel: the premultiplied `f32` canvas, the `f32`
-/// mesh layer and resvg's RGBA8 segment (36), and the mesh renderer's working memory and the
-/// PNG's encoding; the peak measured is 39 bytes a pixel (`docs/svg.md`).
-pub const BYTES_PER_PIXEL: u64 = 16 + 16 + 4 + 8;
+/// The whole picture's memory, in bytes per pixel: the premultiplied canvas (4 bytes, or 8 at
+/// 16 bits with resvg's RGBA8 segment, 4 more) and the PNG's compressed rows (at most about
+/// the 8-bit image's 4 bytes; `docs/svg.md` gives the peaks measured).
+pub fn bytes_per_pixel(sixteen: bool) -> u64 {
+    if sixteen {
+        8 + 4 + 4
+    } else {
+        4 + 4
+    }
+}
 
 /// An error for a panic inside resvg or usvg.
 fn panicked(message: String) -> Error {
@@ -329,8 +337,8 @@ fn check_memory(bytes: u64, max_memory: u64, opts: &RenderOptions) -> Result<(),
     if bytes > max_memory {
         return Err(Error::new(ErrorKind::LimitExceeded {
             what: format!(
-                "the memory the whole picture at {}x{} needs (estimated: {BYTES_PER_PIXEL} \
-                 bytes a pixel and resvg's layers; see --max-memory)",
+                "the memory the whole picture at {}x{} needs (estimated from its bytes a \
+                 pixel and resvg's layers; see --max-memory)",
                 opts.width, opts.height
             ),
             found: bytes,
@@ -340,27 +348,28 @@ fn check_memory(bytes: u64, max_memory: u64, opts: &RenderOptions) -> Result<(),
     Ok(())
 }
 
-/// Renders one segment's text with resvg into a premultiplied RGBA8 pixmap, after checking
-/// the buffers resvg would allocate against `opts.max_pixels` and, with `base` bytes already
-/// in use, `max_memory`. `Ok(Err(message))` when resvg cannot parse the text.
+/// Draws one segment's text with resvg onto `canvas`, after checking the buffers resvg would
+/// allocate against `opts.max_pixels` and, with `base` bytes already in use, `max_memory`.
+/// `Ok(Err(message))` when resvg cannot parse the text.
 fn render_segment(
     text: &str,
     options: &resvg::usvg::Options,
     opts: &RenderOptions,
     (base, max_memory): (u64, u64),
-) -> Result<Result<resvg::tiny_skia::Pixmap, String>, Error> {
+    canvas: &mut Canvas,
+) -> Result<Result<(), String>, Error> {
     let parsed =
         resvg_guard::catching(|| resvg::usvg::Tree::from_str(text, options)).map_err(panicked)?;
     let tree = match parsed {
         Ok(tree) => tree,
         Err(e) => return Ok(Err(e.to_string())),
     };
-    let canvas = resvg_guard::Canvas {
+    let limits = resvg_guard::Canvas {
         width: opts.width,
         height: opts.height,
         max_pixels: opts.max_pixels,
     };
-    let layers = resvg_guard::check_tree(&tree, &canvas).map_err(|e| {
+    let layers = resvg_guard::check_tree(&tree, &limits).map_err(|e| {
         Error::new(ErrorKind::LimitExceeded {
             what: e.what,
             found: e.found,
@@ -368,21 +377,8 @@ fn render_segment(
         })
     })?;
     check_memory(base.saturating_add(layers), max_memory, opts)?;
-    let Some(mut pixmap) = resvg::tiny_skia::Pixmap::new(opts.width, opts.height) else {
-        return Ok(Err(format!(
-            "resvg cannot allocate {}x{}",
-            opts.width, opts.height
-        )));
-    };
-    resvg_guard::catching(|| {
-        resvg::render(
-            &tree,
-            resvg::tiny_skia::Transform::identity(),
-            &mut pixmap.as_mut(),
-        )
-    })
-    .map_err(panicked)?;
-    Ok(Ok(pixmap))
+    resvg_guard::catching(|| canvas.draw_segment(&tree)).map_err(panicked)?;
+    Ok(Ok(()))
 }
 
 /// resvg's options: relative links resolved against `folder` (the file's), the system's fonts, and for each generic family (and text that names no
@@ -465,31 +461,137 @@ fn missing_images(doc: &Document, folder: &Path) -> Vec<String> {
     warnings
 }
 
-/// `over` (premultiplied RGBA8) composited over `acc` (premultiplied `f32`).
-fn composite_pixmap(acc: &mut [f32], over: &resvg::tiny_skia::Pixmap) {
-    for (a, p) in acc.chunks_exact_mut(4).zip(over.data().chunks_exact(4)) {
-        let alpha = p[3] as f32 / 255.0;
-        for c in 0..4 {
-            a[c] = p[c] as f32 / 255.0 + a[c] * (1.0 - alpha);
+/// The whole picture as it is composited, premultiplied: 8-bit, the pixmap resvg draws each
+/// segment straight into, or 16-bit, into which each segment is composited from one pixmap
+/// that every segment reuses. Mesh layers are composited into it band by band
+/// ([`render::render_picture_over`]): no other buffer of the picture's size.
+enum Canvas {
+    Eight(resvg::tiny_skia::Pixmap),
+    Sixteen {
+        canvas: Vec<u16>,
+        segment: resvg::tiny_skia::Pixmap,
+    },
+}
+
+/// The finished picture, straight alpha: 8-bit or 16-bit RGBA.
+pub enum WholePicture {
+    Eight(Vec<u8>),
+    Sixteen(Vec<u16>),
+}
+
+impl Canvas {
+    /// A canvas of `opts`'s size filled with `opts.background` (or clear), 16-bit when
+    /// `sixteen`; `None` when tiny-skia cannot make a pixmap that size.
+    fn new(opts: &RenderOptions, sixteen: bool) -> Option<Canvas> {
+        let pixmap = resvg::tiny_skia::Pixmap::new(opts.width, opts.height)?;
+        let bg = opts.background.map(|bg| {
+            let alpha = bg[3].clamp(0.0, 1.0);
+            [0, 1, 2, 3].map(|c| {
+                if c == 3 {
+                    alpha
+                } else {
+                    bg[c].clamp(0.0, 1.0) * alpha
+                }
+            })
+        });
+        if !sixteen {
+            let mut pixmap = pixmap;
+            if let Some(bg) = bg {
+                let px = bg.map(|v| (v * 255.0).round() as u8);
+                for p in pixmap.data_mut().chunks_exact_mut(4) {
+                    p.copy_from_slice(&px);
+                }
+            }
+            return Some(Canvas::Eight(pixmap));
+        }
+        let px = bg.unwrap_or([0.0; 4]).map(|v| (v * 65535.0).round() as u16);
+        let canvas = px.repeat(opts.width as usize * opts.height as usize);
+        Some(Canvas::Sixteen {
+            canvas,
+            segment: pixmap,
+        })
+    }
+
+    /// Draws a segment parsed by resvg source-over onto the canvas.
+    fn draw_segment(&mut self, tree: &resvg::usvg::Tree) {
+        let identity = resvg::tiny_skia::Transform::identity();
+        match self {
+            Canvas::Eight(pixmap) => resvg::render(tree, identity, &mut pixmap.as_mut()),
+            Canvas::Sixteen { canvas, segment } => {
+                segment.fill(resvg::tiny_skia::Color::TRANSPARENT);
+                resvg::render(tree, identity, &mut segment.as_mut());
+                for (dst, src) in canvas
+                    .chunks_exact_mut(4)
+                    .zip(segment.data().chunks_exact(4))
+                {
+                    if src[3] == 0 {
+                        continue;
+                    }
+                    let keep = 1.0 - f32::from(src[3]) / 255.0;
+                    for c in 0..4 {
+                        let v = f32::from(src[c]) * 257.0 + f32::from(dst[c]) * keep;
+                        dst[c] = v.round().min(65535.0) as u16;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Composites mesh layers onto the canvas.
+    fn draw_meshes(
+        &mut self,
+        layers: &[PictureLayer<'_>],
+        opts: &RenderOptions,
+    ) -> Result<render::RenderInfo, Error> {
+        match self {
+            Canvas::Eight(pixmap) => render::render_picture_over(layers, opts, pixmap.data_mut()),
+            Canvas::Sixteen { canvas, .. } => render::render_picture_over(layers, opts, canvas),
+        }
+    }
+
+    /// The picture with straight alpha, in place.
+    fn into_straight(self) -> WholePicture {
+        match self {
+            Canvas::Eight(pixmap) => {
+                let mut data = pixmap.take();
+                unpremultiply(&mut data, 255);
+                WholePicture::Eight(data)
+            }
+            Canvas::Sixteen {
+                mut canvas,
+                segment,
+            } => {
+                drop(segment);
+                unpremultiply(&mut canvas, 65535);
+                WholePicture::Sixteen(canvas)
+            }
         }
     }
 }
 
-/// `over` (straight `f32`) composited over `acc` (premultiplied `f32`).
-fn composite_image(acc: &mut [f32], over: &[f32]) {
-    for (a, p) in acc.chunks_exact_mut(4).zip(over.chunks_exact(4)) {
-        let alpha = p[3];
-        for c in 0..3 {
-            a[c] = p[c] * alpha + a[c] * (1.0 - alpha);
+/// Premultiplied RGBA pixels whose channels run to `max` made straight, rounding.
+fn unpremultiply<T: Copy + Into<u32> + TryFrom<u32>>(data: &mut [T], max: u32) {
+    for px in data.chunks_exact_mut(4) {
+        let alpha: u32 = px[3].into();
+        if alpha == 0 || alpha == max {
+            continue;
         }
-        a[3] = alpha + a[3] * (1.0 - alpha);
+        for c in 0..3 {
+            let v: u32 = px[c].into();
+            let straight = ((u64::from(v) * u64::from(max) + u64::from(alpha / 2))
+                / u64::from(alpha))
+            .min(u64::from(max)) as u32;
+            if let Ok(s) = T::try_from(straight) {
+                px[c] = s;
+            }
+        }
     }
 }
 
 /// The whole picture of SVG `text` (read from `path`: its relative links are resolved against
 /// its folder, and missing images are warned of): `mesh_layers` (its mesh fills, bottom first, as gradmesh
-/// read them) between the rest of its content drawn by resvg, on `opts.background`. Straight
-/// alpha, like every [`Image`]. `Ok(Err(message))` when the file's content cannot be split
+/// read them) between the rest of its content drawn by resvg, on `opts.background`, in 8-bit
+/// RGBA or, when `sixteen`, 16-bit, straight alpha. `Ok(Err(message))` when the file's content cannot be split
 /// around its mesh fills or resvg cannot read it (the caller then draws the meshes alone).
 /// An error when resvg panics, or when the picture's memory (estimated) is over `max_memory`
 /// or a buffer resvg would allocate is over `opts.max_pixels`.
@@ -497,8 +599,8 @@ pub fn render_whole_picture(
     (path, text): (&Path, &str),
     mesh_layers: &[PictureLayer<'_>],
     opts: &RenderOptions,
-    max_memory: u64,
-) -> Result<Result<(Image, render::RenderInfo), String>, Error> {
+    (max_memory, sixteen): (u64, bool),
+) -> Result<Result<(WholePicture, render::RenderInfo), String>, Error> {
     let doc = match Document::parse_with_options(
         text,
         roxmltree::ParsingOptions {
@@ -521,73 +623,44 @@ pub fn render_whole_picture(
         )));
     }
     let pixels = u64::from(opts.width) * u64::from(opts.height);
-    let base = pixels.saturating_mul(BYTES_PER_PIXEL);
+    let base = pixels.saturating_mul(bytes_per_pixel(sixteen));
     check_memory(base, max_memory, opts)?;
     let folder = path.parent().unwrap_or(Path::new("."));
     for warning in missing_images(&doc, folder) {
         eprintln!("gradmesh: warning: {}: {warning}", path.display());
     }
     let options = resvg_options(folder);
-    let mut acc = background_canvas(opts);
-    let mut layer_opts = opts.clone();
-    layer_opts.background = None;
+    let Some(mut canvas) = Canvas::new(opts, sixteen) else {
+        return Ok(Err(format!(
+            "resvg cannot draw a {}x{} picture",
+            opts.width, opts.height
+        )));
+    };
     let mut info = render::RenderInfo::default();
-    let mut layer = Image::new(opts.width, opts.height);
-    // Mesh layers with nothing drawn between them are rendered together, in one call: the
+    // Mesh layers with nothing drawn between them are composited together, in one call: the
     // layers from `run_start` wait until the next segment that draws, or the end.
     let mut run_start = 0;
-    let mut draw_meshes_below = |end: usize, acc: &mut [f32]| {
+    let mut draw_meshes_below = |end: usize, canvas: &mut Canvas| {
         if run_start < end {
-            layer.data.fill(0.0);
-            let drawn = render::render_picture_into(
-                &mesh_layers[run_start..end],
-                &layer_opts,
-                &mut layer.data,
-            )?;
+            let drawn = canvas.draw_meshes(&mesh_layers[run_start..end], opts)?;
             merge_info(&mut info, drawn, run_start);
-            composite_image(acc, &layer.data);
             run_start = end;
         }
         Ok::<(), Error>(())
     };
     for s in 0..=mesh_layers.len() {
         if segments.drawing[s] {
-            draw_meshes_below(s, &mut acc)?;
-            match render_segment(&segments.text(s), &options, opts, (base, max_memory))? {
-                Ok(pixmap) => composite_pixmap(&mut acc, &pixmap),
-                Err(message) => return Ok(Err(message)),
+            draw_meshes_below(s, &mut canvas)?;
+            let text = segments.text(s);
+            if let Err(message) =
+                render_segment(&text, &options, opts, (base, max_memory), &mut canvas)?
+            {
+                return Ok(Err(message));
             }
         }
     }
-    draw_meshes_below(mesh_layers.len(), &mut acc)?;
-    for px in acc.chunks_exact_mut(4) {
-        if px[3] > 0.0 {
-            for c in 0..3 {
-                px[c] = (px[c] / px[3]).clamp(0.0, 1.0);
-            }
-        }
-    }
-    let image = Image {
-        width: opts.width,
-        height: opts.height,
-        data: acc,
-    };
-    Ok(Ok((image, info)))
-}
-
-/// A premultiplied canvas of the render's size filled with `opts.background` (or clear).
-fn background_canvas(opts: &RenderOptions) -> Vec<f32> {
-    let mut acc = vec![0.0f32; 4 * opts.width as usize * opts.height as usize];
-    if let Some(bg) = opts.background {
-        let alpha = bg[3].clamp(0.0, 1.0) as f32;
-        for px in acc.chunks_exact_mut(4) {
-            for c in 0..3 {
-                px[c] = bg[c].clamp(0.0, 1.0) as f32 * alpha;
-            }
-            px[3] = alpha;
-        }
-    }
-    acc
+    draw_meshes_below(mesh_layers.len(), &mut canvas)?;
+    Ok(Ok((canvas.into_straight(), info)))
 }
 
 /// Adds the report of a render of mesh layers, the first of which is layer `first` of the

@@ -104,6 +104,7 @@ mod nearest;
 mod options;
 mod outline;
 mod output;
+mod over;
 mod overlay;
 mod patches;
 mod png_deflate;
@@ -137,6 +138,7 @@ pub use output::{
     encode_png, encode_png_rgba16, encode_png_rgba8, write_png, write_png_rgba16, write_png_rgba8,
     write_png_rgba8_with, Image, OutputPixel, PngCompression, PngDepth,
 };
+pub use over::CanvasPixel;
 pub use overlay::draw_outlines;
 
 use crate::limit_surface::patches::ShapeCache;
@@ -347,21 +349,15 @@ pub fn render_svg_scene(
     Ok((image, info))
 }
 
-/// Renders the layers of a picture (bottom first) into a caller's buffer, as
-/// [`render_document_into`] does: the same rasteriser and compositor for every source, each
-/// layer clipped to its outline when it has one.
-pub fn render_picture_into<P: OutputPixel>(
+/// Prepares the layers of a picture for drawing, in parallel: each from its source, with its
+/// clip; the first failing layer's error, whatever the thread count.
+fn prepare_picture(
     layers: &[PictureLayer<'_>],
     opts: &RenderOptions,
-    out: &mut [P],
-) -> Result<RenderInfo, Error> {
-    opts.check()?;
-    check_output_buffer(opts, out.len())?;
-    let (w, h) = (opts.width as usize, opts.height as usize);
+) -> Result<Vec<layer::LayerPreparation>, Error> {
     let xf = ToPixels::new(&opts.view, opts.width, opts.height);
-    let start = Instant::now();
     let shapes = ShapeCache::default();
-    let prepared: Vec<layer::LayerPreparation> = layers
+    layers
         .par_iter()
         .enumerate()
         .map(|(i, picture)| {
@@ -383,9 +379,23 @@ pub fn render_picture_into<P: OutputPixel>(
             Ok((info, drawable, warnings))
         })
         .collect::<Vec<Result<_, Error>>>()
-        // The first failing layer's error, whatever the thread count.
         .into_iter()
-        .collect::<Result<_, _>>()?;
+        .collect()
+}
+
+/// Renders the layers of a picture (bottom first) into a caller's buffer, as
+/// [`render_document_into`] does: the same rasteriser and compositor for every source, each
+/// layer clipped to its outline when it has one.
+pub fn render_picture_into<P: OutputPixel>(
+    layers: &[PictureLayer<'_>],
+    opts: &RenderOptions,
+    out: &mut [P],
+) -> Result<RenderInfo, Error> {
+    opts.check()?;
+    check_output_buffer(opts, out.len())?;
+    let (w, h) = (opts.width as usize, opts.height as usize);
+    let start = Instant::now();
+    let prepared = prepare_picture(layers, opts)?;
     let (mut info, drawn, layer_of) =
         describe_layers(prepared.iter().collect(), vec![false; layers.len()]);
     info.timings.prepare = start.elapsed();
@@ -401,6 +411,48 @@ pub fn render_picture_into<P: OutputPixel>(
     drawer.draw_bands(out, None, &dirty, layers.len().max(1));
     info.drawn_bands = dirty.len();
     info.drawn_pixels = (w * h) as u64;
+    info.timings.draw = start.elapsed();
+    Ok(info)
+}
+
+/// Composites the layers of a picture (bottom first) source-over onto `canvas`, an image of
+/// `opts`'s size in premultiplied RGBA (8-bit: tiny-skia's and resvg's pixmap layout, or
+/// 16-bit), on sRGB-encoded values as resvg blends; `opts.background` is not drawn (the canvas
+/// is the background). Each band of rows is drawn into a band-sized buffer and composited onto
+/// the canvas, so the picture costs no image-sized buffer beyond the canvas; an 8-bit canvas
+/// is dithered where the layers draw, when `opts.dither` is set.
+pub fn render_picture_over<P: CanvasPixel>(
+    layers: &[PictureLayer<'_>],
+    opts: &RenderOptions,
+    canvas: &mut [P],
+) -> Result<RenderInfo, Error> {
+    opts.check()?;
+    check_output_buffer(opts, canvas.len())?;
+    let w = opts.width as usize;
+    let start = Instant::now();
+    let prepared = prepare_picture(layers, opts)?;
+    let (mut info, drawn, layer_of) =
+        describe_layers(prepared.iter().collect(), vec![false; layers.len()]);
+    info.timings.prepare = start.elapsed();
+    let start = Instant::now();
+    let drawer = BandDrawer {
+        width: w,
+        layers: &drawn,
+        layer_of: &layer_of,
+        opts,
+        background: None,
+    };
+    canvas
+        .par_chunks_mut(4 * w * BAND)
+        .enumerate()
+        .for_each(|(band, chunk)| {
+            let mut drawn_band = vec![0.0f32; chunk.len()];
+            let mut reach = vec![0.0; layers.len().max(1)];
+            drawer.draw(band, Columns::all(w), &mut drawn_band, &mut reach);
+            over::composite_band_over(chunk, &drawn_band, (w, band * BAND), opts.dither);
+        });
+    info.drawn_bands = opts.height.div_ceil(BAND as u32) as usize;
+    info.drawn_pixels = u64::from(opts.width) * u64::from(opts.height);
     info.timings.draw = start.elapsed();
     Ok(info)
 }
