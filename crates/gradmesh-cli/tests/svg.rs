@@ -555,3 +555,47 @@ fn too_many_parts_between_mesh_fills_draw_the_meshes_alone() {
         "the meshes are drawn"
     );
 }
+
+/// A file that uses the `<mesh>` element of Inkscape 0.92's pre-releases for its mesh
+/// gradients (sample3 with its `meshGradient`s renamed) is drawn whole, as the same file with
+/// `meshGradient`: the ellipse beneath and the stroke over the mesh-filled path are kept.
+#[test]
+fn the_draft_mesh_element_draws_the_rest_of_the_picture() {
+    let source = std::fs::read_to_string(sample("sample3.svg")).unwrap();
+    assert!(
+        source.contains("<meshGradient"),
+        "sample3 uses meshGradient"
+    );
+    let draft = source
+        .replace("<meshGradient", "<mesh")
+        .replace("</meshGradient>", "</mesh>");
+    let dir = tempfile::tempdir().unwrap();
+    let draft_svg = dir.path().join("draft.svg");
+    std::fs::write(&draft_svg, draft).unwrap();
+    let (draft_png, source_png) = (dir.path().join("draft.png"), dir.path().join("source.png"));
+    for (svg, png) in [
+        (draft_svg, &draft_png),
+        (sample("sample3.svg"), &source_png),
+    ] {
+        let out = gradmesh(&["render", svg.to_str().unwrap(), "-o", png.to_str().unwrap()]);
+        let message = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{message}");
+        assert!(!message.contains("only the mesh fills"), "{message}");
+    }
+    let decode = |path: &std::path::Path| {
+        let decoder =
+            png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+        let mut reader = decoder.read_info().unwrap();
+        let mut data = vec![0; reader.output_buffer_size().unwrap()];
+        reader.next_frame(&mut data).unwrap();
+        data
+    };
+    let draft = decode(&draft_png);
+    assert!(draft == decode(&source_png), "the draft's picture differs");
+    // The ellipse (a flat fill drawn by resvg) is there: many opaque pixels of its #80ffb3.
+    let ellipse = draft
+        .chunks_exact(4)
+        .filter(|p| p[..4] == [128, 255, 179, 255])
+        .count();
+    assert!(ellipse > 10_000, "{ellipse} pixels of the ellipse");
+}

@@ -43,6 +43,7 @@ const NOT_DRAWN: &[&str] = &[
     "radialGradient",
     "meshgradient",
     "meshGradient",
+    "mesh",
     "filter",
     "style",
     "script",
@@ -50,6 +51,13 @@ const NOT_DRAWN: &[&str] = &[
     "desc",
     "metadata",
 ];
+
+/// Whether an element named `name` is a mesh gradient as gradmesh reads them
+/// (`formats::svg`): the SVG 2 draft's `meshgradient`, Inkscape 0.91's `meshGradient`, and
+/// the `mesh` of Inkscape 0.92's pre-releases.
+fn is_mesh_gradient(name: &str) -> bool {
+    name.eq_ignore_ascii_case("meshgradient") || name == "mesh"
+}
 
 /// The shapes gradmesh reads mesh fills from (`formats::svg`'s list).
 const SHAPES: &[&str] = &["rect", "circle", "ellipse", "polygon", "polyline", "path"];
@@ -243,7 +251,7 @@ impl<'a, 'input> Segments<'a, 'input> {
     ) -> Result<Self, String> {
         let mesh_ids = doc
             .descendants()
-            .filter(|n| n.tag_name().name().eq_ignore_ascii_case("meshgradient"))
+            .filter(|n| is_svg(*n) && is_mesh_gradient(n.tag_name().name()))
             .filter_map(|n| n.attribute("id"))
             .collect();
         let mut drawn = DrawnElements {
