@@ -210,6 +210,7 @@ function sendView() {
   overlay.height = size.height;
   const v = editor.view;
   send({ type: "view", width: size.width, height: size.height, view: [v.x0, v.y0, v.x1, v.y1] });
+  updateBackdrop();
 }
 
 function zoomAt(sx, sy, factor) {
@@ -819,6 +820,7 @@ function updatePanels() {
   selectPasted(state);
   showFileState(state);
   showRecovery(state);
+  showBackdrops(state);
   $("undo").disabled = !state.can_undo;
   $("redo").disabled = !state.can_redo;
   updateLayerList(state);

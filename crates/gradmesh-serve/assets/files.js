@@ -357,3 +357,45 @@ function selectPasted(state) {
   editor.face = null; editor.edge = null;
   files.selectFrom = null;
 }
+
+// ---- the backdrop of SVG files ----------------------------------------------------------------
+// What an SVG file draws besides its mesh fills: drawn by the server at the canvas's view, under
+// the picture, locked (it takes no clicks); the panel says what is not editable.
+
+function showBackdrops(state) {
+  const backdrops = state.backdrops || [];
+  $("backdrop-info").hidden = backdrops.length === 0;
+  $("backdrop-text").textContent = backdrops.map((b) => b.message).join("; ");
+  const key = backdrops.map((b) => b.file).join("\n");
+  if (key !== showBackdrops.key) {
+    showBackdrops.key = key;
+    updateBackdrop();
+  }
+}
+
+// Asks for the backdrop at the current view, a moment after the view stops changing.
+function updateBackdrop() {
+  clearTimeout(updateBackdrop.timer);
+  updateBackdrop.timer = setTimeout(loadBackdrop, 120);
+}
+
+function loadBackdrop() {
+  const image = $("backdrop");
+  const backdrops = editor.state ? editor.state.backdrops || [] : [];
+  if (backdrops.length === 0 || !$("backdrop-shown").checked || !editor.view) {
+    image.style.display = "none";
+    return;
+  }
+  const size = canvasSize();
+  const v = editor.view;
+  const query = new URLSearchParams({
+    token, width: size.width, height: size.height, x0: v.x0, y0: v.y0, x1: v.x1, y1: v.y1,
+  });
+  const url = `/api/backdrop.png?${query}`;
+  const shown = () => { image.style.display = "block"; image.dataset.view = query.toString(); };
+  image.onload = shown;
+  image.onerror = () => { image.style.display = "none"; };
+  image.src = url;
+}
+
+$("backdrop-shown").addEventListener("change", () => { loadBackdrop(); refocusCanvas(); });

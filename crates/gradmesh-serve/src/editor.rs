@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use gradmesh::formats::{self, Format};
 use gradmesh::{ColourSpace, Document, GradientMesh};
 
+use crate::backdrop::Backdrop;
 use crate::ops::{Applied, Op, Picture};
 
 /// Undo and redo steps kept at most.
@@ -187,13 +188,15 @@ impl Editor {
         }
     }
 
-    /// The document in the file at `path`.
-    pub fn open(path: &Path) -> Result<Editor, String> {
-        let doc = formats::read_path(path).map_err(|e| e.to_string())?;
-        Ok(Editor {
-            history: History::new(Picture::new(doc)),
+    /// The document in the file at `path`, and an SVG file's backdrop
+    /// ([`crate::backdrop::read_document`]).
+    pub fn open(path: &Path) -> Result<(Editor, Option<Backdrop>), String> {
+        let read = crate::backdrop::read_document(path)?;
+        let editor = Editor {
+            history: History::new(Picture::new(read.document)),
             path: Some(save_path_for(path)),
-        })
+        };
+        Ok((editor, read.backdrop))
     }
 
     /// Writes the document as JSON to `path` (atomically) and makes it the file "save" writes.

@@ -11,6 +11,7 @@ use serde_json::{json, Value};
 
 use gradmesh::GradientMesh;
 
+use crate::backdrop::Backdrop;
 use crate::editor::Editor;
 use crate::ops::Picture;
 use crate::recovery::Recovery;
@@ -176,9 +177,11 @@ pub fn save(
     Ok(())
 }
 
-/// The layers of the document in `path`, named after the file where they have no name.
-pub fn read_layers(path: &Path) -> Result<Vec<GradientMesh>, String> {
-    let doc = gradmesh::formats::read_path(path).map_err(|e| e.to_string())?;
+/// The layers of the document in `path`, named after the file where they have no name, and an
+/// SVG file's backdrop.
+pub fn read_layers(path: &Path) -> Result<(Vec<GradientMesh>, Option<Backdrop>), String> {
+    let read = crate::backdrop::read_document(path)?;
+    let doc = read.document;
     let stem = path.file_stem().map(|s| s.to_string_lossy().to_string());
     let count = doc.layers.len();
     let layers = doc.layers.into_iter().enumerate().map(|(i, mut layer)| {
@@ -191,21 +194,29 @@ pub fn read_layers(path: &Path) -> Result<Vec<GradientMesh>, String> {
         }
         layer
     });
-    Ok(layers.collect())
+    Ok((layers.collect(), read.backdrop))
 }
 
 /// Adds the layers of the document `name` (a file of the folder, any format gradmesh reads)
-/// above the layers of `editor`'s document, as one step of the history.
-pub fn import_layers(folder: &Folder, editor: &mut Editor, name: &str) -> Result<(), String> {
+/// above the layers of `editor`'s document, as one step of the history; an SVG file's backdrop
+/// goes above the `backdrops` (it stays when the import is undone).
+pub fn import_layers(
+    folder: &Folder,
+    editor: &mut Editor,
+    backdrops: &mut Vec<Backdrop>,
+    name: &str,
+) -> Result<(), String> {
     let path = folder.resolve(name)?;
-    let layers = read_layers(&path)?;
+    let (layers, backdrop) = read_layers(&path)?;
     if layers.is_empty() {
         return Err(format!("{name} has no layers"));
     }
     let mut next = editor.history.current().clone();
     next.hidden.extend(layers.iter().map(|_| false));
     next.doc.layers.extend(layers);
-    editor.history.replace(next)
+    editor.history.replace(next)?;
+    backdrops.extend(backdrop);
+    Ok(())
 }
 
 /// Adds what the page shows of the files to the state message `state`: `saved` (the file and

@@ -10,6 +10,7 @@
 //! requests whose `Host` or `Origin` is not this server are refused ([`security`]). It reads
 //! and writes documents only inside the starting folder, and saves atomically.
 
+pub mod backdrop;
 pub mod clipboard;
 pub mod editor;
 pub mod exports;
@@ -81,9 +82,11 @@ pub fn open_app(config: &Config) -> Result<Arc<App>, String> {
     };
     let folder = Folder::new(&folder_path)
         .map_err(|e| format!("cannot use the folder {}: {e}", folder_path.display()))?;
+    let mut backdrops = Vec::new();
     let (mut editor, mut source) = match &config.file {
         Some(file) => {
-            let mut editor = Editor::open(file)?;
+            let (mut editor, backdrop) = Editor::open(file)?;
+            backdrops.extend(backdrop);
             // "save" writes inside the folder only.
             if let Some(path) = &editor.path {
                 let name = path.file_name().map(|n| n.to_string_lossy().to_string());
@@ -97,8 +100,9 @@ pub fn open_app(config: &Config) -> Result<Arc<App>, String> {
     if !config.layers_above.is_empty() {
         let mut picture = editor.history.current().clone();
         for file in &config.layers_above {
-            let layers =
+            let (layers, backdrop) =
                 files::read_layers(file).map_err(|e| format!("{}: {e}", file.display()))?;
+            backdrops.extend(backdrop);
             picture.hidden.extend(layers.iter().map(|_| false));
             picture.doc.layers.extend(layers);
         }
@@ -116,6 +120,7 @@ pub fn open_app(config: &Config) -> Result<Arc<App>, String> {
         key.push_str(&file.display().to_string());
     }
     let app = App::new(editor, folder);
+    *app.backdrops() = backdrops;
     let editor = app.editor();
     let warning = app.files().opened(source.as_deref(), &editor, &key);
     drop(editor);

@@ -58,6 +58,7 @@ pub fn router(app: Arc<App>, gate: Gate) -> Router {
         .route("/api/picture.png", get(picture_png))
         .route("/api/refined", get(refined_vertices))
         .route("/api/export", get(crate::exports::export_route))
+        .route("/api/backdrop.png", get(backdrop_png))
         .route("/ws", get(websocket))
         .fallback(|| async { (StatusCode::NOT_FOUND, "no such page") })
         .layer(DefaultBodyLimit::max(MAX_BODY))
@@ -191,6 +192,53 @@ async fn picture_png(State(app): State<Arc<App>>) -> Response {
             bytes,
         )
             .into_response(),
+        Err(e) => (StatusCode::UNPROCESSABLE_ENTITY, e).into_response(),
+    }
+}
+
+/// The view a backdrop is drawn for: the canvas's size in pixels and the rectangle of the plane.
+#[derive(serde::Deserialize)]
+struct BackdropQuery {
+    width: u32,
+    height: u32,
+    x0: f64,
+    y0: f64,
+    x1: f64,
+    y1: f64,
+}
+
+/// `GET /api/backdrop.png?width=W&height=H&x0=…&y0=…&x1=…&y1=…`: what the SVG files opened draw
+/// besides their mesh fills, at that view (204 when there is nothing to draw).
+async fn backdrop_png(State(app): State<Arc<App>>, Query(q): Query<BackdropQuery>) -> Response {
+    let viewport = crate::viewer::Viewport {
+        width: q.width,
+        height: q.height,
+        view: render::View::new(q.x0, q.y0, q.x1, q.y1),
+    };
+    if let Err(e) = viewport.check() {
+        return (StatusCode::BAD_REQUEST, e).into_response();
+    }
+    let backdrops = app.backdrops().clone();
+    let png = tokio::task::spawn_blocking(move || -> Result<Option<Vec<u8>>, String> {
+        let Some(rgba) = crate::backdrop::render(&backdrops, &viewport)? else {
+            return Ok(None);
+        };
+        render::encode_png_rgba8(viewport.width, viewport.height, &rgba)
+            .map(Some)
+            .map_err(|e| e.to_string())
+    })
+    .await
+    .unwrap_or_else(|_| Err("the backdrop's render failed".into()));
+    match png {
+        Ok(Some(bytes)) => (
+            [
+                (header::CONTENT_TYPE, "image/png"),
+                (header::CACHE_CONTROL, "no-store"),
+            ],
+            bytes,
+        )
+            .into_response(),
+        Ok(None) => StatusCode::NO_CONTENT.into_response(),
         Err(e) => (StatusCode::UNPROCESSABLE_ENTITY, e).into_response(),
     }
 }

@@ -43,6 +43,7 @@ pub mod export;
 mod fit;
 mod folds;
 pub mod formats;
+mod join;
 mod level;
 mod limit_matrix;
 mod limit_surface;
@@ -65,6 +66,7 @@ pub use fit::{
     fit_colours, psnr, vectorise, vectorise_with_progress, Progress, Quality, RgbaImage,
     VectoriseOptions, Vectorised, MAX_IMAGE_BYTES, MAX_IMAGE_PIXELS,
 };
+pub use join::{join_meshes, JoinTolerance, Joined};
 pub use limit_matrix::{limit_matrix, LimitMatrix};
 pub use mesh::{ControlPoint, Document, EdgeKind, EdgeTag, GradientMesh, WedgeOverride};
 pub use multires::{ColourEdit, Edit, FineEdits, OpacityEdit, VertexAddress, MAX_EDIT_LEVEL};

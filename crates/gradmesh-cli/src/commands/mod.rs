@@ -5,13 +5,9 @@ mod edits;
 mod info;
 mod refine;
 mod render;
-#[cfg(feature = "svg-whole-picture")]
-mod resvg_guard;
 mod serve;
 mod vectorise;
 mod warnings;
-#[cfg(feature = "svg-whole-picture")]
-mod whole_picture;
 
 use std::path::Path;
 

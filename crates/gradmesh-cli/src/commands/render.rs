@@ -322,11 +322,14 @@ fn whole_svg_picture(
     (max_memory, sixteen): (Option<u64>, bool),
 ) -> Result<Result<(WholePicture, render::RenderInfo), String>, Error> {
     let max_memory = max_memory.unwrap_or_else(machine_memory);
-    super::whole_picture::render_whole_picture(file, layers, opts, (max_memory, sixteen))
+    for warning in gradmesh_svg_picture::missing_images(file) {
+        eprintln!("gradmesh: warning: {}: {warning}", file.0.display());
+    }
+    gradmesh_svg_picture::render_whole_picture(file, layers, opts, (max_memory, sixteen))
 }
 
 #[cfg(feature = "svg-whole-picture")]
-use super::whole_picture::WholePicture;
+use gradmesh_svg_picture::WholePicture;
 
 /// What the whole picture would be drawn as (never made without resvg).
 #[cfg(not(feature = "svg-whole-picture"))]

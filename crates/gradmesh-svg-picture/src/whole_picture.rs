@@ -27,7 +27,7 @@ use gradmesh::render::{self, PictureLayer, RenderOptions};
 use gradmesh::{Error, ErrorKind};
 use roxmltree::{Document, Node};
 
-use super::resvg_guard;
+use crate::resvg_guard;
 
 const SVG_NS: &str = "http://www.w3.org/2000/svg";
 
@@ -123,6 +123,30 @@ fn collect<'a, 'input>(node: Node<'a, 'input>, out: &mut DrawnElements<'a, 'inpu
             }
         }
     }
+}
+
+impl<'a, 'input> DrawnElements<'a, 'input> {
+    /// The drawn elements of `doc`.
+    fn of(doc: &'a Document<'input>) -> Self {
+        let mesh_ids = doc
+            .descendants()
+            .filter(|n| is_svg(*n) && is_mesh_gradient(n.tag_name().name()))
+            .filter_map(|n| n.attribute("id"))
+            .collect();
+        let mut drawn = DrawnElements {
+            mesh_ids,
+            elements: Vec::new(),
+            mesh_shapes: Vec::new(),
+        };
+        collect(doc.root_element(), &mut drawn);
+        drawn
+    }
+}
+
+/// Whether `doc` has a style sheet (whose rules are not read here).
+fn has_style_sheets(doc: &Document) -> bool {
+    doc.descendants()
+        .any(|n| is_svg(n) && n.tag_name().name() == "style")
 }
 
 /// An edit that appends `declaration` to the `style` of `node` (adding the attribute if need be).
@@ -249,17 +273,7 @@ impl<'a, 'input> Segments<'a, 'input> {
         fills: usize,
         opts: &RenderOptions,
     ) -> Result<Self, String> {
-        let mesh_ids = doc
-            .descendants()
-            .filter(|n| is_svg(*n) && is_mesh_gradient(n.tag_name().name()))
-            .filter_map(|n| n.attribute("id"))
-            .collect();
-        let mut drawn = DrawnElements {
-            mesh_ids,
-            elements: Vec::new(),
-            mesh_shapes: Vec::new(),
-        };
-        collect(doc.root_element(), &mut drawn);
+        let drawn = DrawnElements::of(doc);
         if drawn.mesh_shapes.len() != fills {
             return Err(format!(
                 "{} shapes name a mesh gradient as fill, but {fills} mesh fills were read",
@@ -270,9 +284,7 @@ impl<'a, 'input> Segments<'a, 'input> {
         for &i in &drawn.mesh_shapes {
             is_mesh_shape[i] = true;
         }
-        let style_sheets = doc
-            .descendants()
-            .any(|n| is_svg(n) && n.tag_name().name() == "style");
+        let style_sheets = has_style_sheets(doc);
         let mut drawing = vec![false; fills + 1];
         let mut segment = 0;
         for (i, node) in drawn.elements.iter().enumerate() {
@@ -435,9 +447,28 @@ fn resvg_options(folder: &Path) -> resvg::usvg::Options<'static> {
     options
 }
 
-/// Warnings for the `<image>` elements of `doc` whose file is missing: relative links are
-/// resolved against `folder`; other URLs are never fetched.
-fn missing_images(doc: &Document, folder: &Path) -> Vec<String> {
+/// Warnings for the `<image>` elements of SVG `text` (read from `path`) whose file is missing:
+/// relative links are resolved against the file's folder; other URLs are never fetched.
+pub fn missing_images((path, text): (&Path, &str)) -> Vec<String> {
+    match parse(text) {
+        Ok(doc) => images_missing(&doc, path.parent().unwrap_or(Path::new("."))),
+        Err(_) => Vec::new(),
+    }
+}
+
+/// The XML of an SVG file, with its DTD read (entities are common in exported files).
+fn parse(text: &str) -> Result<Document<'_>, roxmltree::Error> {
+    Document::parse_with_options(
+        text,
+        roxmltree::ParsingOptions {
+            allow_dtd: true,
+            ..Default::default()
+        },
+    )
+}
+
+/// The `<image>` elements of `doc` whose file is missing, links resolved against `folder`.
+fn images_missing(doc: &Document, folder: &Path) -> Vec<String> {
     let mut warnings = Vec::new();
     for node in doc
         .descendants()
@@ -483,7 +514,9 @@ enum Canvas {
 
 /// The finished picture, straight alpha: 8-bit or 16-bit RGBA.
 pub enum WholePicture {
+    /// 8-bit RGBA, rows top to bottom.
     Eight(Vec<u8>),
+    /// 16-bit RGBA, rows top to bottom.
     Sixteen(Vec<u16>),
 }
 
@@ -597,7 +630,7 @@ fn unpremultiply<T: Copy + Into<u32> + TryFrom<u32>>(data: &mut [T], max: u32) {
 }
 
 /// The whole picture of SVG `text` (read from `path`: its relative links are resolved against
-/// its folder, and missing images are warned of): `mesh_layers` (its mesh fills, bottom first, as gradmesh
+/// its folder; [`missing_images`] says which images it lacks): `mesh_layers` (its mesh fills, bottom first, as gradmesh
 /// read them) between the rest of its content drawn by resvg, on `opts.background`, in 8-bit
 /// RGBA or, when `sixteen`, 16-bit, straight alpha. `Ok(Err(message))` when the file's content cannot be split
 /// around its mesh fills or resvg cannot read it (the caller then draws the meshes alone).
@@ -609,13 +642,7 @@ pub fn render_whole_picture(
     opts: &RenderOptions,
     (max_memory, sixteen): (u64, bool),
 ) -> Result<Result<(WholePicture, render::RenderInfo), String>, Error> {
-    let doc = match Document::parse_with_options(
-        text,
-        roxmltree::ParsingOptions {
-            allow_dtd: true,
-            ..Default::default()
-        },
-    ) {
+    let doc = match parse(text) {
         Ok(doc) => doc,
         Err(e) => return Ok(Err(e.to_string())),
     };
@@ -634,9 +661,6 @@ pub fn render_whole_picture(
     let base = pixels.saturating_mul(bytes_per_pixel(sixteen));
     check_memory(base, max_memory, opts)?;
     let folder = path.parent().unwrap_or(Path::new("."));
-    for warning in missing_images(&doc, folder) {
-        eprintln!("gradmesh: warning: {}: {warning}", path.display());
-    }
     let options = resvg_options(folder);
     let Some(mut canvas) = Canvas::new(opts, sixteen) else {
         return Ok(Err(format!(
@@ -682,4 +706,104 @@ fn merge_info(info: &mut render::RenderInfo, drawn: render::RenderInfo, first: u
             w.layer = w.layer.map(|l| first + l);
             w
         }));
+}
+
+/// What SVG `text` (read from `path`) draws besides its mesh fills, drawn by resvg at
+/// `opts.width` x `opts.height` showing `opts.view`, on a clear canvas: RGBA8 with straight
+/// alpha, rows top to bottom. Every shape filled with a mesh gradient has its fill left out
+/// (its stroke is drawn). `Ok(Ok(None))` when the file draws nothing but mesh fills;
+/// `Ok(Err(message))` when resvg cannot read it; an error when resvg panics, or when a buffer
+/// it would allocate is over `opts.max_pixels` or the memory over `max_memory`.
+pub fn render_backdrop(
+    (path, text): (&Path, &str),
+    opts: &RenderOptions,
+    max_memory: u64,
+) -> Result<Result<Option<Vec<u8>>, String>, Error> {
+    let doc = match parse(text) {
+        Ok(doc) => doc,
+        Err(e) => return Ok(Err(e.to_string())),
+    };
+    let drawn = DrawnElements::of(&doc);
+    let style_sheets = has_style_sheets(&doc);
+    let draws =
+        drawn.elements.iter().enumerate().any(|(i, node)| {
+            !drawn.mesh_shapes.contains(&i) || may_have_stroke(*node, style_sheets)
+        });
+    if !draws {
+        return Ok(Ok(None));
+    }
+    let mut edits = root_view(doc.root_element(), text, opts);
+    edits.extend(masked_mesh_shapes(&doc, text, &drawn.mesh_ids));
+    for &i in &drawn.mesh_shapes {
+        edits.push(add_style(drawn.elements[i], text, "fill:none"));
+    }
+    let mut clear = opts.clone();
+    clear.background = None;
+    let pixels = u64::from(opts.width) * u64::from(opts.height);
+    let base = pixels.saturating_mul(bytes_per_pixel(false));
+    check_memory(base, max_memory, opts)?;
+    let Some(mut canvas) = Canvas::new(&clear, false) else {
+        return Ok(Err(format!(
+            "resvg cannot draw a {}x{} picture",
+            opts.width, opts.height
+        )));
+    };
+    let options = resvg_options(path.parent().unwrap_or(Path::new(".")));
+    let text = apply(text, edits);
+    if let Err(message) = render_segment(&text, &options, opts, (base, max_memory), &mut canvas)? {
+        return Ok(Err(message));
+    }
+    match canvas.into_straight() {
+        WholePicture::Eight(rgba) => Ok(Ok(Some(rgba))),
+        WholePicture::Sixteen(_) => Ok(Err("an 8-bit canvas gave 16 bits".into())),
+    }
+}
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gradmesh::render::View;
+
+    const PICTURE: &str = r##"<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 100 100">
+      <meshgradient id="m" x="0" y="0" gradientUnits="userSpaceOnUse">
+        <meshrow><meshpatch>
+          <stop path="l 50,0" stop-color="#f00"/><stop path="l 0,50" stop-color="#0f0"/>
+          <stop path="l -50,0" stop-color="#00f"/><stop path="l 0,-50" stop-color="#ff0"/>
+        </meshpatch></meshrow>
+      </meshgradient>
+      <rect width="50" height="50" fill="url(#m)"/>
+      <rect x="60" y="60" width="40" height="40" fill="#000000"/>
+    </svg>"##;
+
+    fn at(rgba: &[u8], width: u32, x: u32, y: u32) -> [u8; 4] {
+        let i = 4 * (y * width + x) as usize;
+        [rgba[i], rgba[i + 1], rgba[i + 2], rgba[i + 3]]
+    }
+
+    #[test]
+    fn the_backdrop_draws_the_rest_and_leaves_the_mesh_fill_out() {
+        let opts = RenderOptions::new(100, 100, View::new(0.0, 0.0, 100.0, 100.0));
+        let rgba = render_backdrop((Path::new("x.svg"), PICTURE), &opts, u64::MAX)
+            .unwrap()
+            .unwrap()
+            .expect("the black square is drawn");
+        assert_eq!(rgba.len(), 4 * 100 * 100);
+        assert_eq!(at(&rgba, 100, 80, 80), [0, 0, 0, 255]);
+        assert_eq!(at(&rgba, 100, 25, 25)[3], 0, "the mesh fill is left out");
+        // The view is the render's: the square's corner moves with it.
+        let shifted = RenderOptions::new(100, 100, View::new(50.0, 50.0, 150.0, 150.0));
+        let rgba = render_backdrop((Path::new("x.svg"), PICTURE), &shifted, u64::MAX)
+            .unwrap()
+            .unwrap()
+            .unwrap();
+        assert_eq!(at(&rgba, 100, 20, 20), [0, 0, 0, 255]);
+        assert_eq!(at(&rgba, 100, 5, 5)[3], 0);
+    }
+
+    #[test]
+    fn a_file_of_mesh_fills_alone_has_no_backdrop() {
+        let only_mesh = PICTURE.replace(r##"fill="#000000""##, r##"fill="url(#m)""##);
+        let opts = RenderOptions::new(50, 50, View::new(0.0, 0.0, 100.0, 100.0));
+        let drawn = render_backdrop((Path::new("x.svg"), &only_mesh), &opts, u64::MAX).unwrap();
+        assert_eq!(drawn, Ok(None));
+    }
 }

@@ -1,0 +1,242 @@
+//! SVG files in the editor: their mesh-gradient fills become layers (the pieces of one mesh
+//! that an export wrote as separate gradients joined again), and what is not a mesh fill is a
+//! locked backdrop under the layers, drawn by resvg at the page's view
+//! ([`gradmesh_svg_picture::render_backdrop`]), with a message saying what cannot be edited.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use gradmesh::formats::{self, svg, Format};
+use gradmesh::render::RenderOptions;
+use gradmesh::{ColourSpace, Document, JoinTolerance, Limits, WarningKind};
+use serde_json::{json, Value};
+
+use crate::viewer::Viewport;
+
+/// The most memory one backdrop render may take, in bytes.
+pub const MAX_BACKDROP_MEMORY: u64 = 1 << 30;
+
+/// What an SVG file draws besides its mesh fills.
+#[derive(Clone, Debug)]
+pub struct Backdrop {
+    /// The file (its relative links are resolved against its folder).
+    pub path: PathBuf,
+    /// Its text.
+    text: String,
+    /// What is not editable, counted by kind.
+    pub message: String,
+}
+
+/// A document read from a file, with the backdrop of an SVG file.
+pub struct Read {
+    /// The document.
+    pub document: Document,
+    /// What an SVG file draws besides its mesh fills (`None` for other formats).
+    pub backdrop: Option<Backdrop>,
+}
+
+/// Reads the document in `path`: an SVG file through [`read_svg`], any other as
+/// `formats::read_path` reads it.
+pub fn read_document(path: &Path) -> Result<Read, String> {
+    if Format::from_path(path) == Some(Format::Svg) {
+        return read_svg(path);
+    }
+    let document = formats::read_path(path).map_err(|e| e.to_string())?;
+    Ok(Read {
+        document,
+        backdrop: None,
+    })
+}
+
+/// Reads the SVG file `path`: its mesh fills as layers in Lab, those that meet along sides
+/// joined into one layer ([`gradmesh::join_meshes`], see [`join_tolerance`]), and the rest of
+/// it as a backdrop.
+pub fn read_svg(path: &Path) -> Result<Read, String> {
+    let limits = Limits::DEFAULT;
+    let bytes = std::fs::metadata(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    if bytes.len() > limits.input_bytes {
+        return Err(format!(
+            "{}: {} bytes, over the limit of {}",
+            path.display(),
+            bytes.len(),
+            limits.input_bytes
+        ));
+    }
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let read = svg::read_document_with_limits(&text, ColourSpace::Lab, &limits)
+        .map_err(|e| e.in_file(path).to_string())?;
+    let tolerance = join_tolerance(&read.document);
+    let layers = gradmesh::join_meshes(&read.document.layers, tolerance);
+    let document = Document {
+        layers: layers.into_iter().map(|joined| joined.mesh).collect(),
+    };
+    let kinds = read.warnings.iter().map(|w| w.kind);
+    let backdrop = Backdrop {
+        path: path.to_path_buf(),
+        text,
+        message: not_editable(path, kinds),
+    };
+    Ok(Read {
+        document,
+        backdrop: Some(backdrop),
+    })
+}
+
+/// How near sides must be to be joined: gradmesh's SVG export writes coordinates to a
+/// thousandth of a unit, and each mesh gradient places its corners by adding up its sides'
+/// rounded steps, so the same corner read from two gradients lies a few thousandths apart; a
+/// hundred-thousandth of the document's extent where that is more. Stop colours are 8-bit
+/// sRGB: a Lab unit covers a step of one.
+pub fn join_tolerance(doc: &Document) -> JoinTolerance {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in doc.layers.iter().flat_map(|l| &l.points) {
+        lo = [lo[0].min(p.position.x), lo[1].min(p.position.y)];
+        hi = [hi[0].max(p.position.x), hi[1].max(p.position.y)];
+    }
+    let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    let extent = if extent.is_finite() { extent } else { 0.0 };
+    JoinTolerance {
+        position: (1e-5 * extent).max(0.02),
+        colour: 1.0,
+        opacity: 0.01,
+    }
+}
+
+/// "NAME: not editable, drawn as a locked backdrop: 3 parts that are not mesh gradients left
+/// out, …" for the warnings of `kinds`.
+fn not_editable(path: &Path, kinds: impl Iterator<Item = WarningKind>) -> String {
+    let mut counts: BTreeMap<String, (WarningKind, usize)> = BTreeMap::new();
+    for kind in kinds {
+        counts.entry(format!("{kind:?}")).or_insert((kind, 0)).1 += 1;
+    }
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
+    if counts.is_empty() {
+        return format!("{name}: every part is a mesh gradient");
+    }
+    let parts: Vec<String> = counts
+        .into_values()
+        .map(|(kind, count)| kind.counted(count))
+        .collect();
+    format!(
+        "{name}: not editable, drawn as a locked backdrop: {}",
+        parts.join(", ")
+    )
+}
+
+/// The backdrops as the state message lists them.
+pub fn describe(backdrops: &[Backdrop], folder_name: impl Fn(&Path) -> String) -> Value {
+    backdrops
+        .iter()
+        .map(|b| json!({"file": folder_name(&b.path), "message": b.message}))
+        .collect()
+}
+
+/// The backdrops drawn one over the other at `viewport`: RGBA8 with straight alpha, or `None`
+/// when none draws anything.
+pub fn render(backdrops: &[Backdrop], viewport: &Viewport) -> Result<Option<Vec<u8>>, String> {
+    let opts = RenderOptions::new(viewport.width, viewport.height, viewport.view);
+    let mut picture: Option<Vec<u8>> = None;
+    for backdrop in backdrops {
+        let drawn = gradmesh_svg_picture::render_backdrop(
+            (&backdrop.path, &backdrop.text),
+            &opts,
+            MAX_BACKDROP_MEMORY,
+        )
+        .map_err(|e| e.to_string())?
+        .map_err(|message| format!("{}: {message}", backdrop.path.display()))?;
+        match (&mut picture, drawn) {
+            (_, None) => {}
+            (None, Some(rgba)) => picture = Some(rgba),
+            (Some(below), Some(above)) => over(below, &above),
+        }
+    }
+    Ok(picture)
+}
+
+/// `above` composited over `below`, both straight-alpha RGBA8.
+fn over(below: &mut [u8], above: &[u8]) {
+    for (b, a) in below.chunks_exact_mut(4).zip(above.chunks_exact(4)) {
+        let (aa, ba) = (f32::from(a[3]) / 255.0, f32::from(b[3]) / 255.0);
+        let alpha = aa + ba * (1.0 - aa);
+        if alpha <= 0.0 {
+            continue;
+        }
+        for c in 0..3 {
+            let value = (f32::from(a[c]) * aa + f32::from(b[c]) * ba * (1.0 - aa)) / alpha;
+            b[c] = value.round().clamp(0.0, 255.0) as u8;
+        }
+        b[3] = (alpha * 255.0).round() as u8;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_message_counts_what_is_left_out_by_kind() {
+        let kinds = [
+            WarningKind::SvgNotMeshFill,
+            WarningKind::SvgNotMeshFill,
+            WarningKind::SvgReadDifferently,
+        ];
+        let message = not_editable(Path::new("/a/art.svg"), kinds.into_iter());
+        assert_eq!(
+            message,
+            "art.svg: not editable, drawn as a locked backdrop: 2 parts that are not mesh \
+             gradients left out, 1 SVG attribute ignored or read differently"
+        );
+    }
+
+    /// The examples `names` as the layers of one document, exported as SVG by the page's
+    /// export and read back by [`read_svg`]: the layers exported, the gradients written, and
+    /// the document read.
+    fn exported_and_read(names: &[&str]) -> (usize, usize, Document) {
+        let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+        let mut doc = Document::default();
+        for name in names {
+            let read = formats::read_path(&examples.join(name))
+                .unwrap_or_else(|e| panic!("the example {name}: {e}"));
+            doc.layers.extend(read.layers);
+        }
+        let svg = crate::exports::export_document(&doc, crate::exports::ExportFormat::Svg, 600)
+            .expect("the SVG export");
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("exported.svg");
+        std::fs::write(&path, svg).unwrap();
+        let fills = formats::read_path(&path).unwrap().layers.len();
+        (doc.layers.len(), fills, read_svg(&path).unwrap().document)
+    }
+
+    #[test]
+    fn an_exported_svg_reads_back_as_one_large_layer_per_layer() {
+        let (exported, fills, doc) = exported_and_read(&["non-rectangular.json", "annulus.json"]);
+        assert!(fills > 500, "the export writes many gradients: {fills}");
+        for mesh in &doc.layers {
+            gradmesh::validate(mesh).unwrap();
+        }
+        // Each layer exported is one mesh but for the finer rings the export writes around its
+        // irregular points, which meet their surroundings at T-junctions and stay apart.
+        let faces: usize = doc.layers.iter().map(|l| l.faces.len()).sum();
+        let large: Vec<usize> = (doc.layers.iter().map(|l| l.faces.len()))
+            .filter(|&n| n > 100)
+            .collect();
+        assert_eq!(
+            large.len(),
+            exported,
+            "{fills} gradients joined into {large:?}"
+        );
+        assert!(large.iter().sum::<usize>() * 100 > 95 * faces);
+        assert!(doc.layers.len() * 50 < fills, "{} layers", doc.layers.len());
+    }
+
+    #[test]
+    fn over_keeps_what_is_below_a_clear_pixel() {
+        let mut below = vec![10, 20, 30, 255, 0, 0, 0, 0];
+        over(&mut below, &[200, 0, 0, 0, 0, 0, 255, 255]);
+        assert_eq!(below, vec![10, 20, 30, 255, 0, 0, 255, 255]);
+    }
+}
