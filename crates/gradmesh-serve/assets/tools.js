@@ -21,10 +21,11 @@
     outline: "Click the outline's corners; click the first again (or Enter) to close it. Esc cancels.",
     loop_cut: "Click an edge: a line of points across its strip of quads. Esc cancels.",
     point: "Click inside a face: a point there, joined to the face's corners. Esc cancels.",
+    trace: "Drag a box over the part of the reference image to trace, or click for all of it. Esc cancels.",
   };
   const buttons = {
     grid: "tool-grid", ellipse: "tool-ellipse", outline: "tool-outline",
-    loop_cut: "tool-loop-cut", point: "tool-point",
+    loop_cut: "tool-loop-cut", point: "tool-point", trace: "tool-trace",
   };
 
   function setMode(mode) {
@@ -61,6 +62,7 @@
     const d = tools.drag;
     tools.drag = null;
     const rect = draggedRect(d);
+    if (tools.mode === "trace") { setMode(null); traceImage(rect); return; }
     if (!rect) { showMessage("Drag over the place the new mesh should fill."); drawOverlay(); return; }
     const layer = targetLayer();
     if (tools.mode === "grid") {
@@ -142,7 +144,7 @@
       return true;
     }
     if (!tools.mode) return false;
-    if (tools.mode === "grid" || tools.mode === "ellipse") {
+    if (tools.mode === "grid" || tools.mode === "ellipse" || tools.mode === "trace") {
       tools.drag = { start: at, at };
     } else {
       clickTool(at);
@@ -177,7 +179,7 @@
   tools.key = (event, key) => {
     if (event.key === "Escape" && tools.mode) { setMode(null); return true; }
     if (event.key === "Enter" && tools.mode === "outline") { finishOutline(); return true; }
-    const mode = { g: "grid", o: "ellipse", p: "outline", l: "loop_cut", i: "point" }[key];
+    const mode = { g: "grid", o: "ellipse", p: "outline", l: "loop_cut", i: "point", t: "trace" }[key];
     if (mode) { setMode(tools.mode === mode ? null : mode); return true; }
     if (key === "x") { dissolve(); return true; }
     if (key === "k") { eyedropper(); return true; }
@@ -192,7 +194,9 @@
     const d = tools.drag;
     if (d) {
       const [x0, y0] = d.start, [x1, y1] = d.at;
-      if (tools.mode === "grid") {
+      if (tools.mode === "trace") {
+        c.strokeRect(Math.min(x0, x1), Math.min(y0, y1), Math.abs(x1 - x0), Math.abs(y1 - y0));
+      } else if (tools.mode === "grid") {
         const [n, m] = [gridSize("grid-columns"), gridSize("grid-rows")];
         c.beginPath();
         for (let i = 0; i <= n; i++) { const x = x0 + (x1 - x0) * i / n; c.moveTo(x, y0); c.lineTo(x, y1); }
@@ -314,6 +318,65 @@
     edit({ op: "set_colours", layer: editor.activeLayer, points, css });
     if (points.length < editor.selection.length) {
       showMessage(`${editor.selection.length - points.length} selected points are outside the image and kept their colours.`);
+    }
+  }
+
+  // ---- trace -------------------------------------------------------------------------------
+
+  // The largest side, in pixels, of the picture sent to be traced: larger parts are scaled
+  // down (the server's fit takes longer with more pixels, and a request is at most 1 MiB).
+  const TRACE_SIDE = 320;
+
+  // The part of the reference image under `rect` (plane coordinates; null: all of it), in
+  // whole image pixels, and the plane rectangle those pixels cover; null if none.
+  function traceRegion(rect) {
+    const ref = tools.reference;
+    const { width, height } = ref.pixels;
+    const perUnit = width / ref.width;
+    const box = rect
+      ? [Math.min(rect[0], rect[2]), Math.min(rect[1], rect[3]), Math.max(rect[0], rect[2]), Math.max(rect[1], rect[3])]
+      : [ref.x, ref.y, ref.x + ref.width, ref.y + height / perUnit];
+    const px0 = Math.max(0, Math.round((box[0] - ref.x) * perUnit));
+    const py0 = Math.max(0, Math.round((box[1] - ref.y) * perUnit));
+    const px1 = Math.min(width, Math.round((box[2] - ref.x) * perUnit));
+    const py1 = Math.min(height, Math.round((box[3] - ref.y) * perUnit));
+    if (px1 - px0 < 4 || py1 - py0 < 4) return null;
+    const plane = [ref.x + px0 / perUnit, ref.y + py0 / perUnit, ref.x + px1 / perUnit, ref.y + py1 / perUnit];
+    return { pixels: [px0, py0, px1 - px0, py1 - py0], plane };
+  }
+
+  // Sends the part of the reference image under `rect` to be traced; the mesh comes back as a
+  // new layer (one undo step), made active.
+  async function traceImage(rect) {
+    if (!tools.reference) { showMessage("Place a reference image first (Tools: Reference image)."); return; }
+    const region = traceRegion(rect);
+    if (!region) { showMessage("Drag the box over the reference image."); return; }
+    const [sx, sy, sw, sh] = region.pixels;
+    const shrink = Math.min(1, TRACE_SIDE / Math.max(sw, sh));
+    const canvas = document.createElement("canvas");
+    canvas.width = Math.max(1, Math.round(sw * shrink));
+    canvas.height = Math.max(1, Math.round(sh * shrink));
+    canvas.getContext("2d").drawImage(image, sx, sy, sw, sh, 0, 0, canvas.width, canvas.height);
+    const png = await new Promise((resolve) => canvas.toBlob(resolve, "image/png"));
+    const points = Math.round(Number($("trace-points").value));
+    const [x0, y0, x1, y1] = region.plane;
+    const query = new URLSearchParams({ token, x0, y0, x1, y1, points: Number.isFinite(points) ? points : 100 });
+    $("tool-trace").disabled = true;
+    $("tool-hint").textContent = "Tracing…";
+    tools.tracing = true;
+    try {
+      const response = await fetch(`/api/trace?${query}`, { method: "POST", body: png, headers: { "Content-Type": "image/png" } });
+      const answer = await response.json().catch(() => ({ message: `the trace failed (${response.status})` }));
+      if (!response.ok) { showMessage(answer.message); return; }
+      editor.chosen = { layer: answer.layer, points: [], face: null };
+      send({ type: "state" });
+      showMessage(`Traced: ${answer.points} points, ${answer.psnr.toFixed(1)} dB against the picture.`);
+    } catch (error) {
+      showMessage(`The trace failed: ${error}`);
+    } finally {
+      tools.tracing = false;
+      $("tool-trace").disabled = false;
+      $("tool-hint").textContent = tools.mode ? hints[tools.mode] : "";
     }
   }
 

@@ -23,6 +23,7 @@ pub mod server;
 pub mod session;
 pub mod state;
 pub mod tools;
+pub mod trace;
 pub mod viewer;
 
 use std::net::SocketAddr;

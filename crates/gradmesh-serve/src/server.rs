@@ -59,6 +59,7 @@ pub fn router(app: Arc<App>, gate: Gate) -> Router {
         .route("/api/refined", get(refined_vertices))
         .route("/api/export", get(crate::exports::export_route))
         .route("/api/backdrop.png", get(backdrop_png))
+        .route("/api/trace", post(trace_route))
         .route("/ws", get(websocket))
         .fallback(|| async { (StatusCode::NOT_FOUND, "no such page") })
         .layer(DefaultBodyLimit::max(MAX_BODY))
@@ -240,6 +241,42 @@ async fn backdrop_png(State(app): State<Arc<App>>, Query(q): Query<BackdropQuery
             .into_response(),
         Ok(None) => StatusCode::NO_CONTENT.into_response(),
         Err(e) => (StatusCode::UNPROCESSABLE_ENTITY, e).into_response(),
+    }
+}
+
+/// `POST /api/trace?x0=…&y0=…&x1=…&y1=…&points=N` with a PNG or JPEG body: a mesh fitted to
+/// the picture (on a blocking thread: the server answers other requests meanwhile), placed
+/// over the rectangle, added as a new layer in one step of the history. The answer:
+/// `{"type": "traced", "layer": L, "points": N, "psnr": DB}`; 422 with a message when the
+/// picture or the request is refused, 409 while a recovery copy waits for the user's choice.
+async fn trace_route(
+    State(app): State<Arc<App>>,
+    Query(request): Query<crate::trace::TraceRequest>,
+    body: Bytes,
+) -> Response {
+    let refused = |status: StatusCode, message: String| {
+        let body = serde_json::json!({"type": "error", "message": message}).to_string();
+        (status, [(header::CONTENT_TYPE, "application/json")], body).into_response()
+    };
+    if app.files().recovery_pending() {
+        let message = "a recovery copy waits: restore or discard it first".to_string();
+        return refused(StatusCode::CONFLICT, message);
+    }
+    let fitted = tokio::task::spawn_blocking(move || crate::trace::trace(&body, &request))
+        .await
+        .unwrap_or_else(|_| Err("the trace failed".into()));
+    let traced = match fitted {
+        Ok(traced) => traced,
+        Err(e) => return refused(StatusCode::UNPROCESSABLE_ENTITY, e),
+    };
+    let (points, psnr) = (traced.points, traced.psnr);
+    let added = crate::trace::add_layer(&mut app.editor(), traced.mesh);
+    match added {
+        Ok(layer) => axum::Json(serde_json::json!({
+            "type": "traced", "layer": layer, "points": points, "psnr": psnr
+        }))
+        .into_response(),
+        Err(e) => refused(StatusCode::UNPROCESSABLE_ENTITY, e),
     }
 }
 

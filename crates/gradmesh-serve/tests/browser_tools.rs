@@ -210,39 +210,7 @@ async fn run_session(client: &Client, running: &Running, dir: &Path) -> Result<(
 /// Places a reference image of four coloured quarters over the document and colours the grid's
 /// left side from it with the eyedropper (a box around the side, K).
 async fn trace_a_colour(client: &Client, dir: &Path) -> Result<(), String> {
-    let (w, h) = (64u32, 64u32);
-    let mut pixels = Vec::with_capacity(4 * 64 * 64);
-    for y in 0..h {
-        for x in 0..w {
-            let colour = match (x < w / 2, y < h / 2) {
-                (true, true) => [255, 0, 0],
-                (false, true) => [0, 255, 0],
-                (true, false) => [0, 0, 255],
-                (false, false) => [255, 255, 0],
-            };
-            pixels.extend_from_slice(&[colour[0], colour[1], colour[2], 255]);
-        }
-    }
-    let png = gradmesh::render::encode_png_rgba8(w, h, &pixels).expect("a PNG");
-    let path = dir.join("quarters.png");
-    std::fs::write(&path, png).unwrap();
-    let input = client
-        .find(Locator::Id("reference-file"))
-        .await
-        .map_err(|e| e.to_string())?;
-    input
-        .send_keys(path.to_str().unwrap())
-        .await
-        .map_err(|e| e.to_string())?;
-    // The image is placed once it has loaded: over the document's points.
-    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
-    while js(client, "return window.gradmesh.tools.reference !== null;").await != json!(true) {
-        assert!(
-            std::time::Instant::now() < deadline,
-            "the reference image did not load"
-        );
-        tokio::time::sleep(std::time::Duration::from_millis(50)).await;
-    }
+    load_quarters(client, dir).await?;
     // Place it over the grid alone: its box is the grid's points 0 to 8.
     let grid = js(
         client,
@@ -284,5 +252,169 @@ async fn trace_a_colour(client: &Client, dir: &Path) -> Result<(), String> {
         "the corners took the image's colours under them"
     );
     screenshot(client, "tools-trace.png").await;
+    Ok(())
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn trace_in_a_real_browser() {
+    let _one = ONE_BROWSER.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let running = start(&Config {
+        file: None,
+        folder: Some(dir.path().to_path_buf()),
+        port: 0,
+        ..Config::default()
+    })
+    .await
+    .unwrap();
+    let (_driver, client) = open_browser().await;
+    let result = trace_session(&client, &running, dir.path()).await;
+    client.close().await.ok();
+    result.expect("the browser session");
+}
+
+/// A new document, the four quarters as reference image: keys typed in
+/// a number field stay there, and Trace makes a layer of the image's left half.
+async fn trace_session(client: &Client, running: &Running, dir: &Path) -> Result<(), String> {
+    client
+        .goto(&running.url())
+        .await
+        .map_err(|e| e.to_string())?;
+    settle(client).await;
+    load_quarters(client, dir).await?;
+    // A square of 200 units, inside the view of a new document (0 to 400 by 0 to 300).
+    type_into(client, "reference-x", "60\n").await?;
+    type_into(client, "reference-y", "40\n").await?;
+    type_into(client, "reference-width", "200\n").await?;
+    number_fields_keep_their_keys(client).await?;
+    trace_the_image(client, [60.0, 40.0, 200.0]).await
+}
+
+/// Keys typed into a number field stay there: "g5" in the grid's columns starts no tool.
+async fn number_fields_keep_their_keys(client: &Client) -> Result<(), String> {
+    type_into(client, "grid-columns", "g5").await?;
+    let typed = js(
+        client,
+        "return [window.gradmesh.tools.mode, document.getElementById('grid-columns').value];",
+    )
+    .await;
+    assert_eq!(
+        typed,
+        json!([null, "5"]),
+        "the keys went to the field alone"
+    );
+    type_into(client, "grid-columns", "2").await
+}
+
+/// Traces the left half of the reference image (placed at `left`, `top`, `side` wide and
+/// high): T, a box dragged over it; a new layer within the box, its corners red and blue.
+async fn trace_the_image(client: &Client, [left, top, side]: [f64; 3]) -> Result<(), String> {
+    let before = js(client, "return window.gradmesh.state.layers.length;").await;
+    let before = before.as_u64().unwrap();
+    type_into(client, "trace-points", "40").await?;
+    press(client, "t").await?;
+    let from = on_screen(client, left - 0.05 * side, top - 0.05 * side).await;
+    let to = on_screen(client, left + 0.5 * side, top + 1.05 * side).await;
+    let by = |a: f64, b: f64| ((b - a.round()) / 10.0).round() * 10.0;
+    drag(client, from, (by(from.0, to.0), by(from.1, to.1))).await;
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(180);
+    while js(client, "return window.gradmesh.state.layers.length;").await != json!(before + 1) {
+        let message = js(client, "return window.gradmesh.error;").await;
+        assert!(
+            std::time::Instant::now() < deadline,
+            "no traced layer ({message})"
+        );
+        tokio::time::sleep(std::time::Duration::from_millis(100)).await;
+    }
+    settle(client).await;
+    let traced = js(
+        client,
+        "const g = window.gradmesh; const l = g.state.layers[g.state.layers.length - 1];          return [l.name, g.activeLayer, l.points, l.hex];",
+    )
+    .await;
+    assert_eq!(traced[0], json!("Trace"));
+    assert_eq!(traced[1], json!(before), "the traced layer is active");
+    let points = traced[2].as_array().unwrap();
+    assert!(points.len() <= 40, "within the budget: {}", points.len());
+    let (mut nearest_top, mut nearest_bottom) = ((f64::MAX, 0), (f64::MAX, 0));
+    for (i, p) in points.iter().enumerate() {
+        let (x, y) = (p[0].as_f64().unwrap(), p[1].as_f64().unwrap());
+        assert!(
+            x >= left - 1e-6
+                && x <= left + 0.55 * side
+                && y >= top - 1e-6
+                && y <= top + side + 1e-6,
+            "point {i} at ({x}, {y}) lies in the box over the image"
+        );
+        let top_distance = (x - left).hypot(y - top);
+        let bottom_distance = (x - left).hypot(y - top - side);
+        if top_distance < nearest_top.0 {
+            nearest_top = (top_distance, i);
+        }
+        if bottom_distance < nearest_bottom.0 {
+            nearest_bottom = (bottom_distance, i);
+        }
+    }
+    let rgb = |i: usize| {
+        let hex = traced[3][i]
+            .as_str()
+            .unwrap()
+            .trim_start_matches('#')
+            .to_string();
+        (0..3)
+            .map(|k| u8::from_str_radix(&hex[2 * k..2 * k + 2], 16).unwrap())
+            .collect::<Vec<u8>>()
+    };
+    let (red, blue) = (rgb(nearest_top.1), rgb(nearest_bottom.1));
+    assert!(red[0] > 180 && red[2] < 90, "the top left is red: {red:?}");
+    assert!(
+        blue[2] > 180 && blue[0] < 90,
+        "the bottom left is blue: {blue:?}"
+    );
+    screenshot(client, "tools-trace-fit.png").await;
+    // One undo step takes the traced layer away.
+    press(client, "\u{E009}z\u{E009}").await?;
+    settle(client).await;
+    let after = js(client, "return window.gradmesh.state.layers.length;").await;
+    assert_eq!(after, json!(before), "undo removes the traced layer");
+    Ok(())
+}
+
+/// Writes a 64 x 64 picture of four coloured quarters (red, green; blue, yellow) and loads it
+/// as the reference image through the file field.
+async fn load_quarters(client: &Client, dir: &Path) -> Result<(), String> {
+    let (w, h) = (64u32, 64u32);
+    let mut pixels = Vec::with_capacity(4 * 64 * 64);
+    for y in 0..h {
+        for x in 0..w {
+            let colour = match (x < w / 2, y < h / 2) {
+                (true, true) => [255, 0, 0],
+                (false, true) => [0, 255, 0],
+                (true, false) => [0, 0, 255],
+                (false, false) => [255, 255, 0],
+            };
+            pixels.extend_from_slice(&[colour[0], colour[1], colour[2], 255]);
+        }
+    }
+    let png = gradmesh::render::encode_png_rgba8(w, h, &pixels).expect("a PNG");
+    let path = dir.join("quarters.png");
+    std::fs::write(&path, png).unwrap();
+    let input = client
+        .find(Locator::Id("reference-file"))
+        .await
+        .map_err(|e| e.to_string())?;
+    input
+        .send_keys(path.to_str().unwrap())
+        .await
+        .map_err(|e| e.to_string())?;
+    // The image is placed once it has loaded: over the document's points.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+    while js(client, "return window.gradmesh.tools.reference !== null;").await != json!(true) {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the reference image did not load"
+        );
+        tokio::time::sleep(std::time::Duration::from_millis(50)).await;
+    }
     Ok(())
 }
