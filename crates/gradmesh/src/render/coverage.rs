@@ -9,6 +9,29 @@
 //!
 //! Rows are independent: a band of rows is accumulated from the segments that cross it alone,
 //! with the same arithmetic whichever band or thread does it.
+//!
+//! Areas are summed in fixed point ([`ONE`] per pixel), and each piece of a segment within a
+//! row adds exactly the difference of its ends' fixed-point heights over its cells. Integer
+//! sums do not depend on the order of the additions, and a closed outline's pieces in a row
+//! add up to exactly zero; so two outlines that differ only between the same two points give
+//! bit-identical sums to the right of every line that differs. A cached render relies on it
+//! to draw again only the columns an outline's change reaches.
+
+/// Fixed-point units per pixel of area: fine beyond the precision of an `f32` coverage, and
+/// far from overflowing an `i64` at any winding number.
+pub(crate) const ONE: f64 = (1u64 << 32) as f64;
+
+/// `v` pixels of area (or of height) in fixed point.
+#[inline]
+fn fixed(v: f64) -> i64 {
+    (v * ONE).round() as i64
+}
+
+/// A fixed-point sum in pixels of area.
+#[inline]
+fn area(sum: i64) -> f64 {
+    sum as f64 * (1.0 / ONE)
+}
 
 /// A directed line segment in pixel coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -37,8 +60,9 @@ impl Line {
 #[derive(Clone, Debug)]
 pub(crate) struct Accumulator {
     width: usize,
-    /// `width + 2` cells a row: a segment's contribution may spill one cell past the image.
-    cells: Vec<f64>,
+    /// `width + 2` cells a row, in fixed point: a segment's contribution may spill one cell
+    /// past the image.
+    cells: Vec<i64>,
     /// Runs of cells `[first, end)` of each row that may be non-zero, in the order added.
     touched: Vec<Vec<[usize; 2]>>,
 }
@@ -48,7 +72,7 @@ impl Accumulator {
     pub fn new(width: usize, rows: usize) -> Accumulator {
         Accumulator {
             width,
-            cells: vec![0.0; (width + 2) * rows],
+            cells: vec![0; (width + 2) * rows],
             touched: vec![Vec::new(); rows],
         }
     }
@@ -62,9 +86,9 @@ impl Accumulator {
     /// `0 .. rows`).
     pub fn add(&mut self, row0: i64, rows: usize, line: &Line) {
         let ([x0, y0], [x1, y1], dir) = if line.p0[1] < line.p1[1] {
-            (line.p0, line.p1, 1.0)
+            (line.p0, line.p1, 1)
         } else if line.p0[1] > line.p1[1] {
-            (line.p1, line.p0, -1.0)
+            (line.p1, line.p0, -1)
         } else {
             return;
         };
@@ -83,14 +107,10 @@ impl Accumulator {
             let xb = if yb == y1 { x1 } else { x0 + (yb - y0) * dxdy };
             let r = (j - row0) as usize;
             let row = &mut self.cells[r * stride..(r + 1) * stride];
-            add_piece(
-                row,
-                self.width as f64,
-                xa,
-                xb,
-                dir * (yb - ya),
-                &mut self.touched[r],
-            );
+            // The heights of the ends in fixed point: the pieces of a chain of segments
+            // share their ends, so their heights add up to the chain's exactly.
+            let height = dir * (fixed(yb) - fixed(ya));
+            add_piece(row, self.width as f64, xa, xb, height, &mut self.touched[r]);
         }
     }
 
@@ -121,7 +141,7 @@ impl Accumulator {
         let row = &mut self.cells[r * stride..(r + 1) * stride];
         let runs = &mut self.touched[r];
         runs.sort_unstable_by_key(|run| run[0]);
-        let mut sum = 0.0;
+        let mut sum = 0i64;
         // Columns before `next` are written.
         let mut next = c0;
         let (mut a, mut b) = (c1, c0);
@@ -135,20 +155,20 @@ impl Accumulator {
                 k += 1;
             }
             let (s, e) = (first.clamp(next, c1), end.clamp(next, c1));
-            out[next..s].fill(coverage_of(sum));
+            out[next..s].fill(coverage_of(area(sum)));
             for (o, &v) in out[s..e].iter_mut().zip(&row[s..e]) {
                 sum += v;
-                *o = coverage_of(sum);
+                *o = coverage_of(area(sum));
             }
             if s < e {
                 a = a.min(s);
                 b = e;
             }
             next = e;
-            row[first..end].fill(0.0);
+            row[first..end].fill(0);
         }
         runs.clear();
-        let tail = coverage_of(sum);
+        let tail = coverage_of(area(sum));
         out[next..c1].fill(tail);
         if tail != 0.0 {
             (a.min(next), c1)
@@ -158,44 +178,53 @@ impl Accumulator {
     }
 }
 
-/// Adds one piece of a segment within one row: from `xa` to `xb`, spanning `d` (signed) of the
-/// row's height. Parts left of the image count fully for every pixel; parts right of it for none.
-/// Records the cells it changes in `touched`.
-fn add_piece(row: &mut [f64], width: f64, xa: f64, xb: f64, d: f64, touched: &mut Vec<[usize; 2]>) {
+/// Adds one piece of a segment within one row: from `xa` to `xb`, spanning `d` (signed, fixed
+/// point) of the row's height. Parts left of the image count fully for every pixel; parts right
+/// of it for none. The cells it changes add up to `d` exactly; it records them in `touched`.
+fn add_piece(row: &mut [i64], width: f64, xa: f64, xb: f64, d: i64, touched: &mut Vec<[usize; 2]>) {
     let (lo, hi) = if xa <= xb { (xa, xb) } else { (xb, xa) };
     if hi <= 0.0 || lo >= width || hi - lo < 1e-9 {
         let x = (0.5 * (xa + xb)).clamp(0.0, width);
         touched.push(add_span(row, x, x, d));
         return;
     }
-    // Split at the image's left and right edges, sharing `d` in proportion to length.
+    // Split at the image's left and right edges, sharing `d` in proportion to length (the
+    // shares rounded as running totals, so that they add up to `d`).
     let len = hi - lo;
     let mut cuts = [lo, lo.max(0.0), hi.min(width), hi];
     cuts.iter_mut().for_each(|c| *c = c.clamp(lo, hi));
+    let share_to = |k: usize| {
+        if k == 3 {
+            d
+        } else {
+            (d as f64 * ((cuts[k] - lo) / len)).round() as i64
+        }
+    };
     for k in 0..3 {
         let (a, b) = (cuts[k], cuts[k + 1]);
         if b <= a {
             continue;
         }
-        let part = d * (b - a) / len;
+        let part = share_to(k + 1) - share_to(k);
         let (a, b) = (a.clamp(0.0, width), b.clamp(0.0, width));
         touched.push(add_span(row, a, b, part));
     }
 }
 
-/// Adds a monotone piece from `x0` to `x1` (`x0 <= x1`, both in `0..=width`) spanning `d`.
-/// Returns the cells `[first, end)` it changed.
-fn add_span(row: &mut [f64], x0: f64, x1: f64, d: f64) -> [usize; 2] {
+/// Adds a monotone piece from `x0` to `x1` (`x0 <= x1`, both in `0..=width`) spanning `d`
+/// (fixed point), whose cells add up to `d` exactly. Returns the cells `[first, end)` it changed.
+fn add_span(row: &mut [i64], x0: f64, x1: f64, d: i64) -> [usize; 2] {
     let c0 = x0.floor() as usize;
     if x1 - x0 < 1e-9 {
         // Vertical: the area right of x in cell c0 is c0 + 1 - x.
         let f = (c0 as f64 + 1.0 - x0).clamp(0.0, 1.0);
-        row[c0] += d * f;
-        row[c0 + 1] += d * (1.0 - f);
+        let first = (d as f64 * f).round() as i64;
+        row[c0] += first;
+        row[c0 + 1] += d - first;
         return [c0, c0 + 2];
     }
     let c1 = x1.ceil() as usize;
-    let s = d / (x1 - x0);
+    let s = d as f64 / (x1 - x0);
     // A(c) = s * integral over [x0, x1] of clamp(c + 1 - x, 0, 1), by the antiderivative
     // H(u) of clamp(1 - u, 0, 1) with u = x - c, taken relative to each cell to keep precision.
     let h = |u: f64| -> f64 {
@@ -207,14 +236,14 @@ fn add_span(row: &mut [f64], x0: f64, x1: f64, d: f64) -> [usize; 2] {
             u - 0.5 * u * u
         }
     };
-    let mut prev = 0.0;
+    let mut prev = 0;
     let last = c1.min(row.len() - 1);
     for c in c0..=last {
         let cf = c as f64;
         let a = if c == c1 {
             d
         } else {
-            s * (h(x1 - cf) - h(x0 - cf))
+            (s * (h(x1 - cf) - h(x0 - cf))).round() as i64
         };
         row[c] += a - prev;
         prev = a;
@@ -262,7 +291,7 @@ mod tests {
         for j in 0..h {
             acc.resolve(j, 0, w, &mut out[j * w..(j + 1) * w]);
         }
-        assert!(acc.cells.iter().all(|&c| c == 0.0), "left cleared");
+        assert!(acc.cells.iter().all(|&c| c == 0), "left cleared");
         out
     }
 
@@ -338,19 +367,78 @@ mod tests {
                 let cells = copy.cells[j * (w + 2)..(j + 1) * (w + 2)].to_vec();
                 let mut out = vec![-1.0; w];
                 let (a, b) = copy.resolve(j, c0, c1, &mut out);
-                let mut sum = 0.0;
+                let mut sum = 0;
                 for i in c0..c1 {
                     sum += cells[i];
-                    assert_eq!(out[i], coverage_of(sum), "row {j} column {i} of {c0}..{c1}");
+                    assert_eq!(
+                        out[i],
+                        coverage_of(area(sum)),
+                        "row {j} column {i} of {c0}..{c1}"
+                    );
                     if !(a..b).contains(&i) {
                         assert_eq!(out[i], 0.0, "row {j} column {i} outside {a}..{b}");
                     }
                 }
                 assert!(out[..c0].iter().chain(&out[c1..]).all(|&v| v == -1.0));
             }
-            assert!(copy.cells.iter().all(|&c| c == 0.0), "left cleared");
+            assert!(copy.cells.iter().all(|&c| c == 0), "left cleared");
             assert!(copy.touched.iter().all(Vec::is_empty));
         }
+    }
+
+    /// The running sums of a row's cells, from column 0.
+    fn prefix_sums(acc: &Accumulator, j: usize) -> Vec<i64> {
+        let stride = acc.width + 2;
+        acc.cells[j * stride..(j + 1) * stride]
+            .iter()
+            .scan(0i64, |sum, &c| {
+                *sum += c;
+                Some(*sum)
+            })
+            .collect()
+    }
+
+    /// Two outlines that differ only in the lines around one moved point have the same sums,
+    /// to the unit, in every column right of the lines that differ, whatever the order the
+    /// lines were added in; and each row of a closed outline sums to exactly zero.
+    #[test]
+    fn outlines_differing_between_the_same_points_match_right_of_the_difference() {
+        let base = [
+            [3.37, 1.21],
+            [17.93, 0.47],
+            [31.11, 2.83],
+            [38.71, 13.39],
+            [29.53, 19.61],
+            [12.29, 18.07],
+            [1.13, 11.73],
+        ];
+        let mut moved = base;
+        moved[5] = [14.81, 16.33];
+        let (w, h) = (48, 21);
+        let accumulate = |lines: &[Line]| {
+            let mut acc = Accumulator::new(w, h);
+            lines.iter().for_each(|l| acc.add(0, h, l));
+            acc
+        };
+        let old = accumulate(&polygon(&base));
+        let mut reversed = polygon(&moved);
+        reversed.reverse();
+        let new = accumulate(&reversed);
+        // The lines that differ: those on each side of point 5.
+        let right = [base[4], base[5], base[6], moved[5]]
+            .iter()
+            .map(|p| p[0])
+            .fold(f64::NEG_INFINITY, f64::max);
+        let first_same = right.ceil() as usize + 1;
+        let mut differ = false;
+        for j in 0..h {
+            let (o, n) = (prefix_sums(&old, j), prefix_sums(&new, j));
+            assert_eq!(o[first_same..], n[first_same..], "row {j}");
+            assert_eq!(*o.last().unwrap(), 0, "row {j} of the first outline");
+            assert_eq!(*n.last().unwrap(), 0, "row {j} of the second");
+            differ |= o != n;
+        }
+        assert!(differ, "the point moved");
     }
 
     #[test]

@@ -181,9 +181,10 @@ impl DrawableLayer {
     /// layer may draw differently from `old`, its last preparation:
     /// - where a triangle of either lies that the other does not hold, bit for bit, at the
     ///   same place ([`TriangleList::for_each_moved`]);
-    /// - from the leftmost outline line that differs in any bit to the layer's right end
-    ///   (coverage is a prefix sum along the row: to the left of a change it is the same sum,
-    ///   to the right only the same up to rounding);
+    /// - from the leftmost to the rightmost outline line that differs in any bit (coverage is
+    ///   a prefix sum along the row, in fixed point: to the left of a change it is the same sum,
+    ///   and to the right too, to the unit, since both outlines are closed: see
+    ///   [`super::coverage`]);
     /// - within `reach[band]` of a boundary segment that changed (the farthest its outline
     ///   pixels there took their colour from when last drawn);
     ///
@@ -259,19 +260,30 @@ impl DrawableLayer {
                 .take(rest)
                 .take_while(|&p| same(p))
                 .count();
+            // The columns of the lines that differ: `(left, right)`.
             let middle = |bin: &[u32], layer: &DrawableLayer| {
-                bin[prefix..bin.len() - suffix]
-                    .iter()
-                    .map(|&i| {
+                bin[prefix..bin.len() - suffix].iter().fold(
+                    (f64::INFINITY, f64::NEG_INFINITY),
+                    |(left, right), &i| {
                         let l = &layer.lines[i as usize];
-                        l.p0[0].min(l.p1[0])
-                    })
-                    .fold(f64::INFINITY, f64::min)
+                        (
+                            left.min(l.p0[0].min(l.p1[0])),
+                            right.max(l.p0[0].max(l.p1[0])),
+                        )
+                    },
+                )
             };
-            let left = middle(a, self).min(middle(b, old));
+            let ((left_new, right_new), (left_old, right_old)) = (middle(a, self), middle(b, old));
+            let (left, right) = (left_new.min(left_old), right_new.max(right_old));
             if left < f64::INFINITY {
-                // The cells a line changes start at the one holding its left end.
-                dirty.include(column(left.floor() - 1.0), self.columns.1.min(width));
+                // The cells a line changes run from the one holding its left end to the one
+                // after its right end (clamped to the image as the accumulation clamps them);
+                // the sums right of those are the same.
+                let end = right.clamp(0.0, width as f64).ceil() as usize + 2;
+                dirty.include(
+                    column(left.floor() - 1.0),
+                    end.min(self.columns.1).min(width),
+                );
             }
         }
     }
@@ -739,12 +751,11 @@ pub(crate) fn visible_outline(
             continue;
         }
         // Coverage can be non-zero from the leftmost to the rightmost line crossing the rows,
-        // including lines right of the image, which themselves add nothing visible.
+        // including lines right of the image. Those add nothing visible but are kept: with
+        // them each row's lines make closed loops, whose sums a cached render relies on
+        // (see `DrawableLayer::mark_changed_columns`).
         c0 = c0.min(l.p0[0]).min(l.p1[0]);
         c1 = c1.max(l.p0[0]).max(l.p1[0]);
-        if l.p0[0] >= w as f64 && l.p1[0] >= w as f64 {
-            continue;
-        }
         let (a, b) = bands_of_rows((r0, r1), h);
         line_ranges.push((lines.len() as u32, a, b));
         lines.push(l);

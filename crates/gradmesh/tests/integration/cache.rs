@@ -8,7 +8,8 @@ use gradmesh::render::{
     document_bounds, render_document_into, render_document_into_cached, RenderCache, RenderOptions,
     View,
 };
-use gradmesh::{ColourSpace, Document};
+use gradmesh::{ColourSpace, Document, GradientMesh};
+use kurbo::Point;
 
 use crate::realdata;
 
@@ -267,5 +268,50 @@ fn edits_draw_again_only_the_columns_they_change() {
             3 * fewer >= 2 * edits,
             "only {fewer} of {edits} edits drew under half their bands' columns"
         );
+    }
+}
+
+/// A change of a layer's outline draws again the columns around the lines that changed, not
+/// the rest of the rows to the layer's right end: coverage sums are exact, so past the change
+/// they are the same. A boundary point on the left side of a wide grid moves; the pixels drawn
+/// again are a small part of the bands they lie in, and the same as a render from scratch, in
+/// 8-bit and float pixels.
+#[test]
+fn an_outline_change_draws_again_only_around_it() {
+    let mut mesh = GradientMesh::new(ColourSpace::Lab);
+    let (columns, rows, cell) = (16u32, 2u32, 10.0);
+    for j in 0..=rows {
+        for i in 0..=columns {
+            let colour = [40.0 + 2.5 * i as f64, 10.0 * j as f64, -20.0];
+            mesh.add_point(Point::new(cell * i as f64, cell * j as f64), colour);
+        }
+    }
+    for j in 0..rows {
+        for i in 0..columns {
+            let v = j * (columns + 1) + i;
+            mesh.add_face(vec![v, v + 1, v + columns + 2, v + columns + 1]);
+        }
+    }
+    let mut doc = Document { layers: vec![mesh] };
+    let opts = options(&doc, 400);
+    let band_pixels = |bands: usize| (bands * 16 * opts.width as usize) as u64;
+    let left_middle = (columns + 1) as usize;
+    for pixels_kind in 0..2 {
+        let mut cache = RenderCache::new();
+        let mut draw = |doc: &Document| match pixels_kind {
+            0 => drawn::<u8>(doc, &opts, &mut cache),
+            _ => drawn::<f32>(doc, &opts, &mut cache),
+        };
+        draw(&doc);
+        for step in [-0.3, 0.3] {
+            doc.layers[0].points[left_middle].position.x += step;
+            let (bands, pixels) = draw(&doc);
+            assert!(bands > 0 && pixels > 0, "nothing drawn again");
+            assert!(
+                3 * pixels < band_pixels(bands),
+                "{pixels} pixels drawn again in {bands} bands of {} pixels",
+                opts.width
+            );
+        }
     }
 }
