@@ -189,8 +189,7 @@ impl DrawableLayer {
     ///   pixels there took their colour from when last drawn);
     ///
     /// and every column of every band when something the whole layer's drawing reads changed
-    /// (its colour space, columns or colour bounds, or the number of boundary segments), or
-    /// when either is clipped.
+    /// (its colour space, columns or colour bounds), or when either is clipped.
     pub fn mark_changed_columns(
         &self,
         old: &DrawableLayer,
@@ -200,20 +199,19 @@ impl DrawableLayer {
     ) {
         let all = Columns::all(width);
         let bounds = |b: &Option<Bounds>| b.map(|b| b.map(|r| r.map(f32::to_bits)));
-        let segments = self.nearest.changed_boxes(&old.nearest);
-        let Some(segments) = segments.filter(|_| {
-            self.clip.is_none()
-                && old.clip.is_none()
-                && !self.covered_by_triangles
-                && !old.covered_by_triangles
-                && self.space == old.space
-                && self.columns == old.columns
-                && bounds(&self.bounds) == bounds(&old.bounds)
-                && self.colours_in_unit_range == old.colours_in_unit_range
-        }) else {
+        let alike = self.clip.is_none()
+            && old.clip.is_none()
+            && !self.covered_by_triangles
+            && !old.covered_by_triangles
+            && self.space == old.space
+            && self.columns == old.columns
+            && bounds(&self.bounds) == bounds(&old.bounds)
+            && self.colours_in_unit_range == old.colours_in_unit_range;
+        if !alike {
             dirty.fill(all);
             return;
-        };
+        }
+        let segments = self.nearest.changed_boxes(&old.nearest);
         let column = |x: f64| x.clamp(0.0, width as f64) as usize;
         // The rows of the bands (the last may reach past the image: the bands are the same).
         let rows = (dirty.len() * BAND) as i64;
@@ -776,9 +774,9 @@ pub(crate) fn visible_outline(
 mod tests {
     use super::*;
 
-    /// A layer of nothing but boundary segments: one every 8 rows, down the image.
-    fn segments_only(bands: usize, shift: Option<usize>) -> DrawableLayer {
-        let segments = (0..2 * bands)
+    /// Boundary segments one every 8 rows, down the image at x 10 (segment `shift` at 10.5).
+    fn segment_list(bands: usize, shift: Option<usize>) -> Vec<Segment> {
+        (0..2 * bands)
             .map(|k| {
                 let y = 8.0 * k as f64;
                 let x = if shift == Some(k) { 10.5 } else { 10.0 };
@@ -790,14 +788,18 @@ mod tests {
                     bump: [0.0; 4],
                 }
             })
-            .collect();
+            .collect()
+    }
+
+    /// A layer of nothing but the boundary segments of [`segment_list`].
+    fn segments_only(bands: usize, shift: Option<usize>) -> DrawableLayer {
         DrawableLayer {
             space: ColourSpace::Lab,
             triangles: TriangleList::default(),
             triangle_bins: Bins::new(bands, &[]),
             lines: Vec::new(),
             line_bins: Bins::new(bands, &[]),
-            nearest: NearestSegments::new(segments),
+            nearest: NearestSegments::new(segment_list(bands, shift)),
             columns: (0, 20),
             bounds: None,
             colours_in_unit_range: false,
@@ -836,13 +838,16 @@ mod tests {
         let mut far = near(1, 21);
         far[3] = far[4];
         assert_eq!(changed(8.0), far);
-        // Another count of segments: every column of every band.
+        // Another count of segments (segment 9 gone, the others in order): the columns within
+        // reach of the segment in neither common end, as if it had moved.
+        let mut kept = segment_list(bands, None);
+        kept.remove(9);
         let fewer = DrawableLayer {
-            nearest: NearestSegments::new(Vec::new()),
+            nearest: NearestSegments::new(kept),
             ..segments_only(bands, None)
         };
         let mut dirty = vec![Columns::NONE; bands];
         fewer.mark_changed_columns(&old, &[0.5; 8], width, &mut dirty);
-        assert_eq!(dirty, [Columns::all(width); 8]);
+        assert_eq!(dirty, near(8, 13));
     }
 }

@@ -33,29 +33,30 @@ pub(crate) struct NearestSegments {
 }
 
 impl NearestSegments {
-    /// The boxes (`[[x0, x1], [y0, y1]]`, pixels) of the segments that differ in any bit
-    /// between `old` and this, in either, when both hold as many: the others keep their
-    /// indices, and an answer (the least distance, then the least index, whatever the grid)
-    /// changes only where a changed segment is as near. `None` for another count.
-    pub fn changed_boxes(&self, old: &NearestSegments) -> Option<Vec<[[f64; 2]; 2]>> {
-        if self.segments.len() != old.segments.len() {
-            return None;
-        }
+    /// The boxes (`[[x0, x1], [y0, y1]]`, pixels) of the segments of `old` and of this that lie
+    /// in neither their common start nor their common end (equal in every bit). The others keep
+    /// their order, and an answer (the least distance, then the least index, whatever the grid)
+    /// changes only where a segment of the changed middle is as near.
+    pub fn changed_boxes(&self, old: &NearestSegments) -> Vec<[[f64; 2]; 2]> {
         let bits = |s: &Segment| {
             (
                 [s.a, s.b].map(|p| p.map(f64::to_bits)),
                 [s.ca, s.cb, s.bump].map(|c| c.map(f32::to_bits)),
             )
         };
+        let (new, old) = (&self.segments, &old.segments);
+        let same = |(a, b): (&Segment, &Segment)| bits(a) == bits(b);
+        let prefix = new.iter().zip(old).take_while(|&p| same(p)).count();
+        let rest = new.len().min(old.len()) - prefix;
+        let suffix = (new.iter().rev().zip(old.iter().rev()))
+            .take(rest)
+            .take_while(|&p| same(p))
+            .count();
         let span = |s: &Segment| [0, 1].map(|k| [s.a[k].min(s.b[k]), s.a[k].max(s.b[k])]);
-        Some(
-            self.segments
-                .iter()
-                .zip(&old.segments)
-                .filter(|(a, b)| bits(a) != bits(b))
-                .flat_map(|(a, b)| [span(a), span(b)])
-                .collect(),
-        )
+        (new[prefix..new.len() - suffix].iter())
+            .chain(&old[prefix..old.len() - suffix])
+            .map(span)
+            .collect()
     }
 
     pub fn new(segments: Vec<Segment>) -> Self {
