@@ -315,11 +315,14 @@ fn bounds(points: &[Point]) -> [f64; 4] {
     r
 }
 
-/// Whether the polygon turns the same way (positive) at every corner.
+/// Whether the polygon turns the same way (positive) at every corner, or goes straight on
+/// (within rounding): the point added on an outline's longest side lies on it, and its inner
+/// point on the line of its neighbours', which rounding alone would otherwise decide.
 fn convex(points: &[Point]) -> bool {
     let n = points.len();
     (0..n).all(|i| {
         let (p, q, r) = (points[i], points[(i + 1) % n], points[(i + 2) % n]);
-        (q - p).cross(r - q) > 0.0
+        let (a, b) = (q - p, r - q);
+        a.cross(b) > -1e-9 * a.hypot() * b.hypot()
     })
 }

@@ -129,6 +129,22 @@ fn an_outline_becomes_quads_or_is_refused_with_a_reason() {
     // quads and three in the middle.
     assert_eq!((mesh.points.len(), mesh.faces.len()), (13, 9));
     assert!(mesh.faces.iter().all(|f| f.len() == 4));
+    // The point added on the longest side makes a straight angle in the middle: the same
+    // faces wherever and at whatever scale the outline is drawn.
+    let corners = [
+        [650.0, 460.0],
+        [820.0, 470.0],
+        [800.0, 600.0],
+        [690.0, 620.0],
+        [640.0, 540.0],
+    ];
+    for k in 0..40 {
+        let (scale, shift) = (0.013 + 0.37 * f64::from(k), -3.7 + 11.3 * f64::from(k));
+        let outline = corners.map(|[x, y]| [shift + scale * x, 0.5 * shift + scale * y]);
+        let mut mesh = GradientMesh::new(ColourSpace::Lab);
+        super::add_outline(&mut mesh, &outline).unwrap();
+        assert_eq!((mesh.points.len(), mesh.faces.len()), (13, 9), "drawn {k}");
+    }
     let mut empty = GradientMesh::new(ColourSpace::Lab);
     let bowtie = [[0.0, 0.0], [10.0, 10.0], [10.0, 0.0], [0.0, 10.0]];
     let err = super::add_outline(&mut empty, &bowtie).unwrap_err();
