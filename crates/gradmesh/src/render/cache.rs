@@ -35,9 +35,9 @@ use crate::limit_surface::patches::ShapeCache;
 /// or outline colours changed are drawn, and the others are copied from it. Within a band of
 /// rows ([`RenderInfo::drawn_bands`](super::RenderInfo::drawn_bands)) that is a range of columns ([`RenderInfo::drawn_pixels`](super::RenderInfo::drawn_pixels)):
 /// those of the triangles that differ, those within reach of a changed boundary segment, and
-/// from the leftmost changed outline line to the layer's right end (coverage is a prefix sum
-/// along the row). Each pixel is computed alone, so the image is the one drawing every pixel
-/// would give. The output buffer may be a fresh one each time; the copy costs one image of
+/// those from the leftmost to the rightmost changed outline line (coverage is a prefix sum
+/// along the row, exact in fixed point: past a change of a closed outline it is the same sum).
+/// Each pixel is computed alone, so the image is the one drawing every pixel would give. The output buffer may be a fresh one each time; the copy costs one image of
 /// memory.
 #[derive(Default)]
 pub struct RenderCache {
