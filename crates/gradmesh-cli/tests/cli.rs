@@ -921,3 +921,23 @@ fn warnings_are_counted_for_convert_and_refine_too() {
         );
     }
 }
+
+/// A reader that stops early (`gradmesh info ... | head`) ends the command quietly with status
+/// 0, not with a panic. The output, a description per file of 2,000, is far more than a pipe
+/// holds, so the command writes after the reader has gone whenever that happens.
+#[test]
+fn info_into_a_closed_pipe_ends_quietly() {
+    let example = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/annulus.json");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_gradmesh"))
+        .arg("info")
+        .args(std::iter::repeat_n(example, 2000))
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("the command ends");
+    let err = stderr(&out);
+    assert!(out.status.success(), "{:?}: {err}", out.status);
+    assert!(!err.contains("panicked"), "{err}");
+}

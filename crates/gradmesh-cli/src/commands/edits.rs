@@ -6,6 +6,7 @@ use gradmesh::Refinement;
 use gradmesh::{ColourEdit, Edit, Error, OpacityEdit};
 
 use crate::args::EditsArgs;
+use crate::output::out;
 
 pub fn run(args: &EditsArgs, report: &mut super::WarningReport) -> Result<(), Error> {
     let doc = super::read(&args.input, &args.limits.limits(), 1, report)?;
@@ -50,7 +51,7 @@ pub fn run(args: &EditsArgs, report: &mut super::WarningReport) -> Result<(), Er
             .unwrap();
         }
     }
-    print!("{out}");
+    out!("{out}");
     Ok(())
 }
 

@@ -9,6 +9,7 @@ use gradmesh::{EdgeKind, Error, GradientMesh};
 
 use super::Failure;
 use crate::args::InfoArgs;
+use crate::output::{out, outln};
 
 /// Describes every file, reporting each error as it comes; fails with the count of failures
 /// (each already printed) if any file or layer could not be described.
@@ -21,13 +22,13 @@ pub fn run(args: &InfoArgs) -> Result<(), Failure> {
         read_warnings.print();
         match read {
             Ok(doc) => {
-                println!("{}", path.display());
+                outln!("{}", path.display());
                 for (i, mesh) in doc.layers.iter().enumerate() {
                     match describe(mesh) {
                         Ok((text, warnings)) => {
-                            print!("  layer {i}{text}");
+                            out!("  layer {i}{text}");
                             for w in warnings {
-                                println!("    warning: {w}");
+                                outln!("    warning: {w}");
                             }
                         }
                         Err(e) => {
