@@ -7,6 +7,7 @@ use std::collections::{BTreeMap, HashMap};
 use kurbo::{Point, Vec2};
 
 use crate::mesh::{edge_key, GradientMesh, WedgeOverride};
+use crate::union_find::UnionFind;
 use crate::validate::validate;
 
 /// How close two sides must be to count as one.
@@ -287,34 +288,6 @@ fn mark_corners(mesh: &mut GradientMesh) {
     }
     for p in turns {
         mesh.points[p as usize].corner = true;
-    }
-}
-
-/// Disjoint sets of indices.
-struct UnionFind {
-    parent: Vec<usize>,
-}
-
-impl UnionFind {
-    fn new(n: usize) -> Self {
-        UnionFind {
-            parent: (0..n).collect(),
-        }
-    }
-
-    fn find(&mut self, mut k: usize) -> usize {
-        while self.parent[k] != k {
-            self.parent[k] = self.parent[self.parent[k]];
-            k = self.parent[k];
-        }
-        k
-    }
-
-    /// Joins the sets of `a` and `b`; the smaller index stays the representative.
-    fn union(&mut self, a: usize, b: usize) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        let (keep, join) = if ra <= rb { (ra, rb) } else { (rb, ra) };
-        self.parent[join] = keep;
     }
 }
 

@@ -56,6 +56,7 @@ mod scheme;
 mod size_limits;
 mod ternary_step;
 mod topology;
+mod union_find;
 mod validate;
 mod view;
 

@@ -9,6 +9,7 @@ use super::scene::{MeshFill, MeshGrid, SvgScene};
 use crate::colour::{parse_css_colour, ColourSpace};
 use crate::error::{Warning, WarningKind};
 use crate::mesh::{edge_key, ControlPoint, Document, GradientMesh};
+use crate::union_find::UnionFind;
 
 /// The document of every fill of `scene`, one layer per fill in paint order, with colours in
 /// `space`, and the warnings of the reading and of the conversion.
@@ -232,33 +233,4 @@ fn hex_colour(rgb: [f64; 3]) -> Option<String> {
             bytes[0] as u8, bytes[1] as u8, bytes[2] as u8
         )
     })
-}
-
-/// Disjoint sets of corner indices.
-struct UnionFind {
-    parent: Vec<usize>,
-}
-
-impl UnionFind {
-    fn new(n: usize) -> Self {
-        UnionFind {
-            parent: (0..n).collect(),
-        }
-    }
-
-    fn find(&mut self, mut k: usize) -> usize {
-        while self.parent[k] != k {
-            self.parent[k] = self.parent[self.parent[k]];
-            k = self.parent[k];
-        }
-        k
-    }
-
-    /// Joins the sets of `a` and `b`; the smaller index stays the representative, so that a
-    /// merged point takes the colour of the corner read first.
-    fn union(&mut self, a: usize, b: usize) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        let (keep, join) = if ra <= rb { (ra, rb) } else { (rb, ra) };
-        self.parent[join] = keep;
-    }
 }
