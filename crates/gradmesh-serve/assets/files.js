@@ -358,13 +358,15 @@ function selectPasted(state) {
   files.selectFrom = null;
 }
 
-// ---- the backdrop of SVG files ----------------------------------------------------------------
+// ---- the backdrop of SVG and PDF files ------------------------------------------------------------
 // What an SVG file draws besides its mesh fills: drawn by the server at the canvas's view, under
-// the picture, locked (it takes no clicks); the panel says what is not editable.
+// the picture, locked (it takes no clicks); the panel says what is not editable. A PDF file's
+// other content is not drawn: the panel only says what was left out.
 
 function showBackdrops(state) {
   const backdrops = state.backdrops || [];
   $("backdrop-info").hidden = backdrops.length === 0;
+  $("backdrop-shown").parentElement.hidden = !backdrops.some((b) => b.drawn);
   $("backdrop-text").textContent = backdrops.map((b) => b.message).join("; ");
   const key = backdrops.map((b) => b.file).join("\n");
   if (key !== showBackdrops.key) {
@@ -382,7 +384,7 @@ function updateBackdrop() {
 function loadBackdrop() {
   const image = $("backdrop");
   const backdrops = editor.state ? editor.state.backdrops || [] : [];
-  if (backdrops.length === 0 || !$("backdrop-shown").checked || !editor.view) {
+  if (!backdrops.some((b) => b.drawn) || !$("backdrop-shown").checked || !editor.view) {
     image.style.display = "none";
     return;
   }

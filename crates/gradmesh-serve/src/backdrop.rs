@@ -1,12 +1,14 @@
-//! SVG files in the editor: their mesh-gradient fills become layers (the pieces of one mesh
-//! that an export wrote as separate gradients joined again), and what is not a mesh fill is a
-//! locked backdrop under the layers, drawn by resvg at the page's view
-//! ([`gradmesh_svg_picture::render_backdrop`]), with a message saying what cannot be edited.
+//! SVG and PDF files in the editor. An SVG file's mesh-gradient fills become layers (the pieces
+//! of one mesh that an export wrote as separate gradients joined again), and what is not a mesh
+//! fill is a locked backdrop under the layers, drawn by resvg at the page's view
+//! ([`gradmesh_svg_picture::render_backdrop`]), with a message saying what cannot be edited. A
+//! PDF file's patch-mesh shadings become layers; what else its page holds is not drawn, and the
+//! message says what was left out.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use gradmesh::formats::{self, svg, Format};
+use gradmesh::formats::{self, pdf, svg, Format};
 use gradmesh::render::RenderOptions;
 use gradmesh::{ColourSpace, Document, JoinTolerance, Limits, WarningKind};
 use serde_json::{json, Value};
@@ -16,30 +18,42 @@ use crate::viewer::Viewport;
 /// The most memory one backdrop render may take, in bytes.
 pub const MAX_BACKDROP_MEMORY: u64 = 1 << 30;
 
-/// What an SVG file draws besides its mesh fills.
+/// What an SVG or PDF file holds besides the layers read from it.
 #[derive(Clone, Debug)]
 pub struct Backdrop {
     /// The file (its relative links are resolved against its folder).
     pub path: PathBuf,
-    /// Its text.
-    text: String,
+    /// An SVG file's text, drawn as the backdrop; `None` for a PDF file, whose other content
+    /// is not drawn.
+    svg_text: Option<String>,
     /// What is not editable, counted by kind.
     pub message: String,
 }
 
-/// A document read from a file, with the backdrop of an SVG file.
+impl Backdrop {
+    /// Whether the backdrop draws anything (an SVG file's other content).
+    pub fn is_drawn(&self) -> bool {
+        self.svg_text.is_some()
+    }
+}
+
+/// A document read from a file, with the backdrop of an SVG or PDF file.
 pub struct Read {
     /// The document.
     pub document: Document,
-    /// What an SVG file draws besides its mesh fills (`None` for other formats).
+    /// What an SVG or PDF file holds besides the layers (`None` for other formats, and for a
+    /// PDF file from which nothing was left out).
     pub backdrop: Option<Backdrop>,
 }
 
-/// Reads the document in `path`: an SVG file through [`read_svg`], any other as
-/// `formats::read_path` reads it.
+/// Reads the document in `path`: an SVG file through [`read_svg`], a PDF or `.ai` file through
+/// [`read_pdf`], any other as `formats::read_path` reads it.
 pub fn read_document(path: &Path) -> Result<Read, String> {
     if Format::from_path(path) == Some(Format::Svg) {
         return read_svg(path);
+    }
+    if formats::is_pdf_path(path) {
+        return read_pdf(path);
     }
     let document = formats::read_path(path).map_err(|e| e.to_string())?;
     Ok(Read {
@@ -73,13 +87,47 @@ pub fn read_svg(path: &Path) -> Result<Read, String> {
     let kinds = read.warnings.iter().map(|w| w.kind);
     let backdrop = Backdrop {
         path: path.to_path_buf(),
-        text,
+        svg_text: Some(text),
         message: not_editable(path, kinds),
     };
     Ok(Read {
         document,
         backdrop: Some(backdrop),
     })
+}
+
+/// Reads the first page of the PDF (or `.ai`) file `path`: one layer in Lab per patch-mesh
+/// shading painted, and a backdrop that draws nothing but says what the page holds besides,
+/// when something was left out or read differently.
+pub fn read_pdf(path: &Path) -> Result<Read, String> {
+    let read = pdf::read_path_with_limits(path, 1, &Limits::DEFAULT).map_err(|e| e.to_string())?;
+    let messages: Vec<&str> = read.warnings.iter().map(|w| w.message.as_str()).collect();
+    let backdrop = (!messages.is_empty()).then(|| Backdrop {
+        path: path.to_path_buf(),
+        svg_text: None,
+        message: left_out_of_pdf(path, &messages),
+    });
+    Ok(Read {
+        document: read.document,
+        backdrop,
+    })
+}
+
+/// "NAME: only its patch-mesh shadings are read; left out or read differently: text is not
+/// drawn; …"
+/// for the warnings `messages` of a PDF file.
+fn left_out_of_pdf(path: &Path, messages: &[&str]) -> String {
+    format!(
+        "{}: only its patch-mesh shadings are read; left out or read differently: {}",
+        file_name(path),
+        messages.join("; ")
+    )
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default()
 }
 
 /// How near sides must be to be joined: gradmesh's SVG export writes coordinates to a
@@ -109,10 +157,7 @@ fn not_editable(path: &Path, kinds: impl Iterator<Item = WarningKind>) -> String
     for kind in kinds {
         counts.entry(format!("{kind:?}")).or_insert((kind, 0)).1 += 1;
     }
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().to_string())
-        .unwrap_or_default();
+    let name = file_name(path);
     if counts.is_empty() {
         return format!("{name}: every part is a mesh gradient");
     }
@@ -130,7 +175,7 @@ fn not_editable(path: &Path, kinds: impl Iterator<Item = WarningKind>) -> String
 pub fn describe(backdrops: &[Backdrop], folder_name: impl Fn(&Path) -> String) -> Value {
     backdrops
         .iter()
-        .map(|b| json!({"file": folder_name(&b.path), "message": b.message}))
+        .map(|b| json!({"file": folder_name(&b.path), "message": b.message, "drawn": b.is_drawn()}))
         .collect()
 }
 
@@ -140,8 +185,11 @@ pub fn render(backdrops: &[Backdrop], viewport: &Viewport) -> Result<Option<Vec<
     let opts = RenderOptions::new(viewport.width, viewport.height, viewport.view);
     let mut picture: Option<Vec<u8>> = None;
     for backdrop in backdrops {
+        let Some(text) = &backdrop.svg_text else {
+            continue;
+        };
         let drawn = gradmesh_svg_picture::render_backdrop(
-            (&backdrop.path, &backdrop.text),
+            (&backdrop.path, text),
             &opts,
             MAX_BACKDROP_MEMORY,
         )

@@ -195,11 +195,16 @@ impl Folder {
             }
             if real.is_dir() && depth < 3 && entry.path() == real {
                 self.collect_documents(&real, depth + 1, names);
-            } else if real.is_file() && gradmesh::formats::Format::from_path(&real).is_some() {
+            } else if real.is_file() && is_document(&real) {
                 names.push(self.name_of(&entry.path()));
             }
         }
     }
+}
+
+/// Whether `path` names a file the editor can open, by its extension.
+fn is_document(path: &Path) -> bool {
+    gradmesh::formats::Format::from_path(path).is_some() || gradmesh::formats::is_pdf_path(path)
 }
 
 #[cfg(test)]

@@ -277,3 +277,134 @@ async fn layers_come_from_several_files_and_imports_and_faces_are_pasted() {
     let (_, state) = command(&running, r#"{"type":"state"}"#).await;
     assert_eq!(state["layers"][1]["points"].as_array().unwrap().len(), 12);
 }
+
+/// A one-page PDF file (300 x 200 points) that writes a line of text and paints one Coons
+/// patch over (0, 0)-(255, 255) with `sh`, its corners red, green, blue and white; the
+/// cross-reference table is correct.
+fn pdf_with_text_and_a_patch() -> Vec<u8> {
+    let mut record = vec![0u8];
+    let sides: [(u8, u8); 12] = [
+        (0, 0),
+        (0, 85),
+        (0, 170),
+        (0, 255),
+        (85, 255),
+        (170, 255),
+        (255, 255),
+        (255, 170),
+        (255, 85),
+        (255, 0),
+        (170, 0),
+        (85, 0),
+    ];
+    record.extend(sides.iter().flat_map(|&(x, y)| [x, y]));
+    record.extend([255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255]);
+    let stream = |dict: &str, data: &[u8]| {
+        let mut s = format!("<< {dict} /Length {} >>\nstream\n", data.len()).into_bytes();
+        s.extend(data);
+        s.extend(b"\nendstream");
+        s
+    };
+    let objects = [
+        b"<< /Type /Catalog /Pages 2 0 R >>".to_vec(),
+        b"<< /Type /Pages /Kids [3 0 R] /Count 1 >>".to_vec(),
+        b"<< /Type /Page /Parent 2 0 R /MediaBox [0 0 300 200] /Contents 4 0 R \
+           /Resources << /Shading << /S0 5 0 R >> >> >>"
+            .to_vec(),
+        stream("", b"BT /F1 12 Tf (words) Tj ET /S0 sh"),
+        stream(
+            "/ShadingType 6 /ColorSpace /DeviceRGB /BitsPerCoordinate 8 /BitsPerComponent 8 \
+             /BitsPerFlag 8 /Decode [0 255 0 255 0 1 0 1 0 1]",
+            &record,
+        ),
+    ];
+    let mut out = b"%PDF-1.7\n".to_vec();
+    let mut offsets = Vec::new();
+    for (k, body) in objects.iter().enumerate() {
+        offsets.push(out.len());
+        out.extend(format!("{} 0 obj\n", k + 1).as_bytes());
+        out.extend(body);
+        out.extend(b"\nendobj\n");
+    }
+    let xref = out.len();
+    out.extend(format!("xref\n0 {}\n0000000000 65535 f \n", objects.len() + 1).as_bytes());
+    for o in offsets {
+        out.extend(format!("{o:010} 00000 n \n").as_bytes());
+    }
+    let trailer = format!(
+        "trailer\n<< /Size {} /Root 1 0 R >>\nstartxref\n{xref}\n%%EOF\n",
+        objects.len() + 1
+    );
+    out.extend(trailer.as_bytes());
+    out
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_pdf_opens_with_its_shadings_as_layers_and_says_what_was_left_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let pdf = dir.path().join("art.pdf");
+    std::fs::write(&pdf, pdf_with_text_and_a_patch()).unwrap();
+    let running = serve(Some(pdf), dir.path()).await;
+    let (_, state) = command(&running, r#"{"type":"state"}"#).await;
+    let layers = state["layers"].as_array().unwrap();
+    assert_eq!(layers.len(), 1, "{state}");
+    // The patch's corners, y flipped in the 200 pt page: red at (0, 200), white at (255, 200).
+    let at = |x: f64, y: f64| {
+        let points = layers[0]["points"].as_array().unwrap();
+        let k = points.iter().position(|p| *p == serde_json::json!([x, y]));
+        let k = k.unwrap_or_else(|| panic!("no point at ({x}, {y}): {points:?}"));
+        layers[0]["hex"][k].as_str().unwrap().to_string()
+    };
+    assert_eq!(at(0.0, 200.0), "#ff0000");
+    assert_eq!(at(0.0, -55.0), "#00ff00");
+    assert_eq!(at(255.0, -55.0), "#0000ff");
+    assert_eq!(at(255.0, 200.0), "#ffffff");
+
+    let backdrops = state["backdrops"].as_array().unwrap();
+    assert_eq!(backdrops.len(), 1, "{state}");
+    let message = backdrops[0]["message"].as_str().unwrap();
+    assert!(
+        message.starts_with("art.pdf: only its patch-mesh shadings are read; left out")
+            && message.contains("text is not drawn"),
+        "{message}"
+    );
+    assert_eq!(backdrops[0]["drawn"], false);
+    let view = "/api/backdrop.png?width=64&height=64&x0=0&y0=0&x1=300&y1=200";
+    assert_eq!(
+        get(&running, view).await.0,
+        204,
+        "nothing of a PDF is drawn"
+    );
+
+    // The folder lists it, the menu opens and imports it, and a save writes art.json.
+    let (status, body, _) = get(&running, "/api/files?").await;
+    assert_eq!(status, 200);
+    let names: Vec<String> = serde_json::from_slice(&body).unwrap();
+    assert_eq!(names, ["art.pdf"]);
+    let (status, state) = command(&running, r#"{"type":"import_layers","name":"art.pdf"}"#).await;
+    assert_eq!(status, 200, "{state}");
+    assert_eq!(state["layers"].as_array().unwrap().len(), 2);
+    let (status, state) = command(&running, r#"{"type":"save"}"#).await;
+    assert_eq!(status, 200, "{state}");
+    assert_eq!(state["file"], "art.json");
+    let saved = gradmesh::formats::read_path(&dir.path().join("art.json")).unwrap();
+    assert_eq!(saved.layers.len(), 2);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_pdf_without_a_patch_mesh_shading_is_refused_with_its_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let square = dir.path().join("square.json");
+    std::fs::write(&square, SQUARE).unwrap();
+    let empty = pdf_with_text_and_a_patch();
+    let text = String::from_utf8_lossy(&empty).replace("/S0 sh", "      ");
+    std::fs::write(dir.path().join("words.pdf"), text.as_bytes()).unwrap();
+    let running = serve(Some(square), dir.path()).await;
+    let (status, answer) = command(&running, r#"{"type":"open","name":"words.pdf"}"#).await;
+    assert_eq!(status, 422, "{answer}");
+    let message = answer["message"].as_str().unwrap();
+    assert!(
+        message.contains("words.pdf") && message.contains("no shading of type 6 or 7"),
+        "{message}"
+    );
+}
