@@ -24,6 +24,11 @@ const editor = {
   refined: null,        // {layer, face, level, vertices, chosen}: refined vertices shown
   nextGesture: 1,
   error: "",
+  // Drag latency, in milliseconds of the page's clock: a drag's move waits in `moves` until
+  // the batch that carries it goes out, then in `inFlight` until that batch's answer (its
+  // frame drawn) comes; `samples` keeps each move's time to its frame, the newest 4,000.
+  latency: { moves: [], inFlight: [], samples: [] },
+  overlayQueued: false, // the overlay is to be drawn at the next animation frame
 };
 window.gradmesh = editor;
 
@@ -73,6 +78,17 @@ function flush() {
   }
   editor.pending = [];
   editor.busy = true;
+  editor.latency.inFlight.push(...editor.latency.moves);
+  editor.latency.moves = [];
+}
+
+// The batch out is answered: its frame is on the canvas.
+function noteFrameReady() {
+  const latency = editor.latency;
+  const now = performance.now();
+  for (const moved of latency.inFlight) latency.samples.push(now - moved);
+  latency.inFlight = [];
+  if (latency.samples.length > 4000) latency.samples.splice(0, latency.samples.length - 4000);
 }
 
 function edit(op, gesture) {
@@ -84,6 +100,7 @@ function edit(op, gesture) {
 function receiveText(message) {
   if (message.type === "done") {
     editor.busy = false;
+    noteFrameReady();
     flush();
   } else if (message.type === "error" && answerRefusal(message)) {
     // files.js asked the user.
@@ -112,7 +129,7 @@ function receiveText(message) {
     if (first) fitView();
     if (editor.refined) loadRefined(editor.refined.layer, editor.refined.face, editor.refined.level);
     updatePanels();
-    drawOverlay();
+    requestOverlay();
   }
 }
 
@@ -152,14 +169,21 @@ function drawFrame(buffer) {
 
 // ---- view ---------------------------------------------------------------------------------
 
+// The canvas's size, read from the layout once per task (the overlay converts thousands of
+// points with it, and the layout does not change while a script runs): forgotten when the
+// running script ends.
+let measuredSize = null;
 function canvasSize() {
+  if (measuredSize) return measuredSize;
   const rect = overlay.getBoundingClientRect();
   const ratio = window.devicePixelRatio || 1;
-  return {
+  measuredSize = {
     cssWidth: rect.width, cssHeight: rect.height, ratio,
     width: Math.max(1, Math.round(rect.width * ratio)),
     height: Math.max(1, Math.round(rect.height * ratio)),
   };
+  queueMicrotask(() => { measuredSize = null; });
+  return measuredSize;
 }
 
 function scale() {
@@ -254,6 +278,17 @@ function edgeStyle(kind, sharpness) {
   return { colour: "#ffffff", width: 1, dash: [] };
 }
 
+// Draws the overlay at the next animation frame, once however often it is asked for in
+// between (a drag asks on every move and every answer).
+function requestOverlay() {
+  if (editor.overlayQueued) return;
+  editor.overlayQueued = true;
+  requestAnimationFrame(() => {
+    editor.overlayQueued = false;
+    drawOverlay();
+  });
+}
+
 function drawOverlay() {
   const size = canvasSize();
   const c = overlayContext;
@@ -272,47 +307,98 @@ function drawOverlay() {
     c.fillStyle = "#4a90e255";
     c.fill();
   }
+  drawEdges(c, layer);
+  const selected = new Set(editor.selection);
+  drawHandles(c, layer, selected);
+  drawPoints(c, layer, selected);
+  drawSides(c, layer);
+  drawRefined(c);
+  for (const [x, y] of layer.folds) {
+    const [sx, sy] = toScreen(x, y);
+    c.strokeStyle = "#f33"; c.lineWidth = 2;
+    c.beginPath(); c.arc(sx, sy, 12, 0, 2 * Math.PI); c.stroke();
+    c.fillStyle = "#f33"; c.font = "bold 12px sans-serif"; c.fillText("fold", sx + 14, sy + 4);
+  }
+  drawBox(c);
+}
+
+// The mesh lines, one path per look (plain, crease, discontinuous, the selected edge), each
+// stroked twice: a dark line under a light one.
+function drawEdges(c, layer) {
+  const paths = new Map();
   for (const [a, b, kind, sharpness] of layer.edges) {
-    const [p0, p1, p2, p3] = edgeCurve(layer, a, b);
-    const style = edgeStyle(kind, sharpness);
     const selected = editor.edge && editor.edge[0] === a && editor.edge[1] === b;
+    const key = selected ? `selected ${kind} ${sharpness === null}` : `${kind} ${sharpness === null}`;
+    if (!paths.has(key)) paths.set(key, { path: new Path2D(), style: edgeStyle(kind, sharpness), selected });
+    const [p0, p1, p2, p3] = edgeCurve(layer, a, b);
+    const path = paths.get(key).path;
+    path.moveTo(...p0);
+    path.bezierCurveTo(...p1, ...p2, ...p3);
+  }
+  // Plain lines first, the selected edge last, so tagged and chosen edges show above.
+  const order = [...paths.values()].sort((x, y) => rank(x) - rank(y));
+  function rank(entry) { return entry.selected ? 2 : entry.style.width > 1 ? 1 : 0; }
+  for (const { path, style, selected } of order) {
     c.setLineDash([]);
     c.strokeStyle = "#000a";
     c.lineWidth = style.width + 2;
-    c.beginPath(); c.moveTo(...p0); c.bezierCurveTo(...p1, ...p2, ...p3); c.stroke();
+    c.stroke(path);
     c.setLineDash(style.dash);
     c.strokeStyle = selected ? "#4af" : style.colour;
     c.lineWidth = selected ? style.width + 1.5 : style.width;
-    c.beginPath(); c.moveTo(...p0); c.bezierCurveTo(...p1, ...p2, ...p3); c.stroke();
+    c.stroke(path);
   }
   c.setLineDash([]);
-  for (const p of editor.selection) {
-    for (const [from, to] of layer.handles) {
-      if (from !== p) continue;
-      const end = handleEnd(layer, from, to);
-      const start = toScreen(...layer.points[from]);
-      c.strokeStyle = "#4af"; c.lineWidth = 1;
-      c.beginPath(); c.moveTo(...start); c.lineTo(...end); c.stroke();
-      c.fillStyle = "#fff";
-      c.beginPath(); c.arc(...end, 3.5, 0, 2 * Math.PI); c.fill(); c.stroke();
-    }
+}
+
+function drawHandles(c, layer, selected) {
+  if (selected.size === 0) return;
+  const lines = new Path2D();
+  const ends = new Path2D();
+  for (const [from, to] of layer.handles) {
+    if (!selected.has(from)) continue;
+    const end = handleEnd(layer, from, to);
+    lines.moveTo(...toScreen(...layer.points[from]));
+    lines.lineTo(...end);
+    ends.moveTo(end[0] + 3.5, end[1]);
+    ends.arc(...end, 3.5, 0, 2 * Math.PI);
   }
+  c.strokeStyle = "#4af"; c.lineWidth = 1;
+  c.stroke(lines);
+  c.fillStyle = "#fff";
+  c.fill(ends);
+  c.stroke(ends);
+}
+
+// Each point a square of its colour; outlines and out-of-gamut rings one path each.
+function drawPoints(c, layer, selected) {
+  const outlines = new Path2D();
+  const chosen = new Path2D();
+  const rings = new Path2D();
+  const outOfGamut = new Set(layer.out_of_gamut);
   layer.points.forEach(([x, y], i) => {
     const [sx, sy] = toScreen(x, y);
-    const selected = editor.selection.includes(i);
-    const r = selected ? 6 : 4.5;
+    const isSelected = selected.has(i);
+    const r = isSelected ? 6 : 4.5;
     c.fillStyle = layer.hex[i];
-    c.strokeStyle = selected ? "#4af" : "#000";
-    c.lineWidth = selected ? 2.5 : 1.5;
     c.fillRect(sx - r, sy - r, 2 * r, 2 * r);
-    c.strokeRect(sx - r, sy - r, 2 * r, 2 * r);
-    if (layer.out_of_gamut.includes(i)) {
-      c.strokeStyle = "#fa0"; c.lineWidth = 1.5;
-      c.beginPath(); c.arc(sx, sy, r + 4, 0, 2 * Math.PI); c.stroke();
+    (isSelected ? chosen : outlines).rect(sx - r, sy - r, 2 * r, 2 * r);
+    if (outOfGamut.has(i)) {
+      rings.moveTo(sx + r + 4, sy);
+      rings.arc(sx, sy, r + 4, 0, 2 * Math.PI);
     }
   });
+  c.strokeStyle = "#000"; c.lineWidth = 1.5;
+  c.stroke(outlines);
+  c.strokeStyle = "#4af"; c.lineWidth = 2.5;
+  c.stroke(chosen);
+  c.strokeStyle = "#fa0"; c.lineWidth = 1.5;
+  c.stroke(rings);
+}
+
+// A dot inside the face, near the point: the colour of that side.
+function drawSides(c, layer) {
   for (const [p, f, hex] of layer.sides) {
-    // A dot inside the face, near the point: the colour of that side.
     const corners = layer.faces[f];
     if (!corners) continue;
     const centre = corners.reduce((acc, q) => [acc[0] + layer.points[q][0] / corners.length,
@@ -322,14 +408,6 @@ function drawOverlay() {
     c.fillStyle = hex; c.strokeStyle = "#000"; c.lineWidth = 1.5;
     c.beginPath(); c.arc(sx, sy, 4, 0, 2 * Math.PI); c.fill(); c.stroke();
   }
-  drawRefined(c);
-  for (const [x, y] of layer.folds) {
-    const [sx, sy] = toScreen(x, y);
-    c.strokeStyle = "#f33"; c.lineWidth = 2;
-    c.beginPath(); c.arc(sx, sy, 12, 0, 2 * Math.PI); c.stroke();
-    c.fillStyle = "#f33"; c.font = "bold 12px sans-serif"; c.fillText("fold", sx + 14, sy + 4);
-  }
-  drawBox(c);
 }
 
 function drawRefined(c) {
@@ -497,7 +575,10 @@ overlay.addEventListener("pointerdown", (event) => {
 
 overlay.addEventListener("pointermove", (event) => {
   if (editor.tools && editor.tools.pointerMove(event, eventPosition(event))) return;
-  if (editor.drag) dragTo(editor.drag, eventPosition(event));
+  if (!editor.drag) return;
+  // The event's time is when the input arrived, so the wait for the page's turn counts too.
+  if (editor.drag.gesture !== undefined) editor.latency.moves.push(event.timeStamp);
+  dragTo(editor.drag, eventPosition(event));
 });
 
 // Follows a drag to `at` (screen pixels of the overlay).
@@ -513,24 +594,24 @@ function dragTo(d, at) {
     d.moved = true;
     d.points.forEach((p, i) => { layer.points[p] = [d.origins[i][0] + dx, d.origins[i][1] + dy]; });
     edit({ op: "move_points", layer: editor.activeLayer, points: d.points, dx, dy }, d.gesture);
-    drawOverlay();
+    requestOverlay();
   } else if (d.kind === "handle") {
     d.moved = true;
     const [from, to] = d.handle;
     const [x, y] = [d.origin[0] + dx, d.origin[1] + dy];
     layer.handles = layer.handles.map((h) => (h[0] === from && h[1] === to ? [from, to, x, y] : h));
     edit({ op: "set_handle", layer: editor.activeLayer, from, to, x, y }, d.gesture);
-    drawOverlay();
+    requestOverlay();
   } else if (d.kind === "refined") {
     // The server sets the vertex's position offset so that its limit position moves by this.
     d.moved = true;
     d.vertex.position = [d.origin[0] + dx, d.origin[1] + dy];
     edit({ op: "move_refined_vertex", layer: d.layer, level: d.level, face: d.face,
       point: d.vertex.point, at: d.vertex.at, dx, dy }, d.gesture);
-    drawOverlay();
+    requestOverlay();
   } else if (d.kind === "box") {
     d.at = at;
-    drawOverlay();
+    requestOverlay();
   }
 }
 

@@ -1,10 +1,12 @@
 //! The editor's edit path on the paper authors' Tucan (six layers), Paprika (three) and Glasses
-//! (one mesh, faces up to 14 sides) in a 1024-pixel-wide view: from the command text reaching
-//! the session to the frame bytes and the state ready to send (applying, validation, the cached
-//! render, the changed rows, the state JSON).
+//! (one mesh, faces up to 14 sides) in the view the page first shows on a 1024 x 900 canvas: from
+//! the command text reaching the session to the frame bytes and the state ready to send
+//! (applying, validation, the cached render, the changed rows, the state JSON).
 //!
 //! For each artwork it edits the costliest points: the drag of the point whose move takes the
-//! longest to render, and the colour change of the point whose change redraws the most pixels.
+//! longest to render, and the colour change of the point whose change redraws the most pixels;
+//! then the drags of the browser test (`drag_latency_in_a_real_browser`). A drag moves as the
+//! browser test's mouse does: out by 12 pixels and back, 2 pixels a step.
 //!
 //! `cargo bench -p gradmesh-serve --bench edit_latency`. Besides criterion's figures it prints,
 //! per artwork and edit, the median, 95th percentile and worst of 100 steps, and for the drag
@@ -26,6 +28,8 @@ use gradmesh_serve::{App, Editor, History, Outgoing, Picture, Session};
 
 const REAL: &str = "../../../shared/realdata/gradientmeshimproved-off";
 const WIDTH: u32 = 1024;
+/// The picture's height: the editor's canvas in the browser test's window (1324 x 900).
+const HEIGHT: u32 = 900;
 
 /// The artworks: name and files, the bottom layer first.
 const ARTWORKS: [(&str, &[&str]); 3] = [
@@ -51,6 +55,15 @@ const ARTWORKS: [(&str, &[&str]); 3] = [
     ("glasses", &["Glasses.off"]),
 ];
 
+/// The drags the browser test measures (`tests/browser.rs`, `drag_latency_in_a_real_browser`):
+/// artwork, layer and point.
+const BROWSER_DRAGS: [(&str, usize, usize); 4] = [
+    ("tucan", 3, 28),
+    ("paprika", 1, 37),
+    ("glasses", 0, 74),
+    ("glasses", 0, 64),
+];
+
 fn artwork(files: &[&str]) -> Document {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(REAL);
     let layers = files
@@ -65,22 +78,34 @@ fn artwork(files: &[&str]) -> Document {
     Document { layers }
 }
 
-/// The options of the editor's view of `doc`, 1024 pixels wide.
+/// The options of the editor's first view of `doc` on a canvas of 1024 x 900 pixels, as the
+/// page fits it: the document's bounds with 8% of their longer side around, widened to the
+/// canvas's shape about their centre.
 fn options(doc: &Document) -> RenderOptions {
-    let bounds = View::fit(doc, 0.02);
-    let height = (WIDTH as f64 * bounds.height() / bounds.width()).round() as u32;
-    RenderOptions::new(WIDTH, height, bounds)
+    let b = View::fit(doc, 0.08);
+    let aspect = WIDTH as f64 / HEIGHT as f64;
+    let width = b.width().max(b.height() * aspect);
+    let height = width / aspect;
+    let (cx, cy) = (0.5 * (b.x0 + b.x1), 0.5 * (b.y0 + b.y1));
+    let view = View::new(
+        cx - 0.5 * width,
+        cy - 0.5 * height,
+        cx + 0.5 * width,
+        cy + 0.5 * height,
+    );
+    RenderOptions::new(WIDTH, HEIGHT, view)
 }
 
-/// A layer and point of the artwork.
+/// A layer and point of the artwork, and the size of a pixel of the view in plane units.
 #[derive(Clone, Copy, Debug)]
 struct Target {
     layer: usize,
     point: usize,
+    pixel: f64,
 }
 
 /// The point whose change of colour redraws the most pixels, and the point whose move (by 2
-/// units, as a drag step) takes the longest to render, each through a `RenderCache` as the
+/// pixels, as a drag step) takes the longest to render, each through a `RenderCache` as the
 /// editor renders (the quicker of two tries, against interference).
 fn costliest_points(doc: &Document, opts: &RenderOptions) -> (Target, Target) {
     let mut cache = RenderCache::new();
@@ -89,12 +114,31 @@ fn costliest_points(doc: &Document, opts: &RenderOptions) -> (Target, Target) {
         render::render_document_into_cached(d, opts, cache, &mut pixels).expect("renders")
     };
     render(doc, &mut cache);
-    let mut colour = (0, Target { layer: 0, point: 0 });
-    let mut drag = (Duration::ZERO, Target { layer: 0, point: 0 });
+    let pixel = opts.view.width() / opts.width as f64;
+    let mut colour = (
+        0,
+        Target {
+            layer: 0,
+            point: 0,
+            pixel,
+        },
+    );
+    let mut drag = (
+        Duration::ZERO,
+        Target {
+            layer: 0,
+            point: 0,
+            pixel,
+        },
+    );
     let mut edited = doc.clone();
     for layer in 0..doc.layers.len() {
         for point in 0..doc.layers[layer].points.len() {
-            let target = Target { layer, point };
+            let target = Target {
+                layer,
+                point,
+                pixel,
+            };
             edited.layers[layer].points[point].colour[0] += 30.0;
             let info = render(&edited, &mut cache);
             edited.layers[layer].points[point].colour[0] -= 30.0;
@@ -104,11 +148,11 @@ fn costliest_points(doc: &Document, opts: &RenderOptions) -> (Target, Target) {
             }
             let mut quickest = Duration::MAX;
             for _ in 0..2 {
-                edited.layers[layer].points[point].position.x += 2.0;
+                edited.layers[layer].points[point].position.x += 2.0 * pixel;
                 let start = Instant::now();
                 render(&edited, &mut cache);
                 quickest = quickest.min(start.elapsed());
-                edited.layers[layer].points[point].position.x -= 2.0;
+                edited.layers[layer].points[point].position.x -= 2.0 * pixel;
                 render(&edited, &mut cache);
             }
             if quickest > drag.0 {
@@ -139,14 +183,18 @@ fn session(doc: &Document) -> Session {
     session
 }
 
+/// Step `step` of a drag as the browser test makes it: out by 12 pixels and back, 2 pixels a
+/// step, with 1 pixel up and down at every other step (offsets from where the drag began).
 fn drag_command(t: Target, step: usize) -> String {
-    // Back and forth by up to 3 units (a few pixels), as a mouse drag does.
-    let dx = 3.0 * ((step % 8) as f64 / 4.0 - 1.0);
+    let phase = step % 12;
+    let dx = 2.0 * if phase <= 6 { phase } else { 12 - phase } as f64;
+    let dy = (step % 2) as f64;
     format!(
-        r#"{{"type":"edit","gesture":1,"op":{{"op":"move_points","layer":{},"points":[{}],"dx":{dx},"dy":{}}}}}"#,
+        r#"{{"type":"edit","gesture":1,"op":{{"op":"move_points","layer":{},"points":[{}],"dx":{},"dy":{}}}}}"#,
         t.layer,
         t.point,
-        dx / 2.0
+        dx * t.pixel,
+        dy * t.pixel
     )
 }
 
@@ -294,6 +342,16 @@ fn main() {
             report(name, "drag", &doc, drag, drag_command);
             report(name, "colour", &doc, colour, colour_command);
             profile_drag(name, &doc, drag);
+            for &(artwork, layer, point) in BROWSER_DRAGS.iter().filter(|d| d.0 == name) {
+                if (layer, point) != (drag.layer, drag.point) {
+                    let t = Target {
+                        layer,
+                        point,
+                        ..drag
+                    };
+                    report(artwork, "drag", &doc, t, drag_command);
+                }
+            }
         }
     }
     benches();

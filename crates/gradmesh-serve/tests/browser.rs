@@ -12,6 +12,7 @@ mod support;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use fantoccini::actions::{InputSource, MouseActions, PointerAction, MOUSE_BUTTON_LEFT};
 use fantoccini::{Client, Locator};
 use gradmesh_serve::{start, Config, Running};
 use serde_json::json;
@@ -329,18 +330,29 @@ async fn run_session(client: &Client, running: &Running, file: &Path) -> Result<
 
 /// The paper authors' Tucan (six layers, bottom first) as one document in `dir`.
 fn write_tucan(dir: &Path) -> PathBuf {
+    let files: Vec<String> = (0..6)
+        .rev()
+        .map(|i| format!("Tucan_Tucan_Layer{i}.off"))
+        .collect();
+    write_artwork(dir, "tucan", &files)
+}
+
+/// The paper authors' artwork files (`../shared/realdata/gradientmeshimproved-off`, bottom
+/// layer first) as one document `NAME.json` in `dir`, so that the editor's recovery copy goes
+/// beside it.
+fn write_artwork(dir: &Path, name: &str, files: &[String]) -> PathBuf {
     let source = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/realdata/gradientmeshimproved-off");
-    let layers = (0..6)
-        .rev()
-        .map(|i| {
-            let path = source.join(format!("Tucan_Tucan_Layer{i}.off"));
+    let layers = files
+        .iter()
+        .map(|file| {
+            let path = source.join(file);
             let mut doc = gradmesh::formats::read_path(&path)
-                .unwrap_or_else(|e| panic!("the Tucan artwork ({}): {e}", path.display()));
+                .unwrap_or_else(|e| panic!("the artwork file {}: {e}", path.display()));
             doc.layers.remove(0)
         })
         .collect();
-    let file = dir.join("tucan.json");
+    let file = dir.join(format!("{name}.json"));
     let text = gradmesh::formats::json::write_document(&gradmesh::Document { layers });
     std::fs::write(&file, text).unwrap();
     file
@@ -418,4 +430,175 @@ async fn show_tucan(client: &Client, running: &Running) -> Result<(), String> {
 fn dir_file(running: &Running) -> PathBuf {
     let editor = running.app.editor();
     editor.path.clone().expect("the document's file")
+}
+
+/// The drags whose latency the page measures: artwork, its files (bottom first), and the
+/// layer and point dragged (the costliest drags of `benches/edit_latency.rs`, and a point
+/// inside Glasses' lens).
+fn latency_drags() -> Vec<(&'static str, Vec<String>, usize, usize)> {
+    let tucan = (0..6)
+        .rev()
+        .map(|i| format!("Tucan_Tucan_Layer{i}.off"))
+        .collect::<Vec<_>>();
+    let paprika = (0..3)
+        .rev()
+        .map(|i| format!("Paprika_Paprika_layer{i}.off"))
+        .collect::<Vec<_>>();
+    let glasses = vec!["Glasses.off".to_string()];
+    vec![
+        ("tucan", tucan, 3, 28),
+        ("paprika", paprika, 1, 37),
+        ("glasses", glasses.clone(), 0, 74),
+        ("glasses", glasses, 0, 64),
+    ]
+}
+
+/// The time from a mouse move to its frame on the canvas, as the page measures it
+/// (`window.gradmesh.latency`), for a drag on each artwork with the picture 1024 pixels wide.
+/// Prints the median, 95th percentile and worst (`-- --nocapture`); asserts that every move
+/// was answered by a frame and that the drag moved the point.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn drag_latency_in_a_real_browser() {
+    let _one = ONE_BROWSER.lock().await;
+    let dir = tempfile::tempdir().unwrap();
+    let (_driver, client) = open_browser().await;
+    let mut result = Ok(());
+    for (name, files, layer, point) in latency_drags() {
+        let file = write_artwork(dir.path(), name, &files);
+        let running = start(&Config {
+            file: Some(file),
+            folder: None,
+            port: 0,
+            ..Config::default()
+        })
+        .await
+        .unwrap();
+        result = measure_drag(&client, &running, name, layer, point).await;
+        running.task.abort();
+        if result.is_err() {
+            break;
+        }
+    }
+    client.close().await.ok();
+    result.expect("the browser session");
+}
+
+/// Opens the artwork with a picture 1024 pixels wide, drags the point back and forth with 120
+/// mouse moves 16 ms apart, and reports the page's figures.
+async fn measure_drag(
+    client: &Client,
+    running: &Running,
+    name: &str,
+    layer: usize,
+    point: usize,
+) -> Result<(), String> {
+    client
+        .set_window_size(1024 + 300, WINDOW.1)
+        .await
+        .map_err(|e| e.to_string())?;
+    client
+        .goto(&running.url())
+        .await
+        .map_err(|e| e.to_string())?;
+    settle(client).await;
+    let width = js(client, "return document.getElementById('picture').width;").await;
+    assert_eq!(width, json!(1024), "the picture's width in pixels");
+    js(
+        client,
+        &format!("window.gradmesh.activeLayer = {layer}; window.gradmesh.selection = [];"),
+    )
+    .await;
+    let before = server_point(running, layer, point);
+    let at = point_on_layer(client, layer, point).await;
+    let moves = 120;
+    let mut mouse = MouseActions::new("mouse".into())
+        .then(PointerAction::MoveTo {
+            duration: None,
+            x: at.0.round(),
+            y: at.1.round(),
+        })
+        .then(PointerAction::Down {
+            button: MOUSE_BUTTON_LEFT,
+        });
+    for step in 0..moves {
+        // Out by 12 pixels and back, 2 pixels a move, as a hand moves a point to and fro.
+        let dx = if (step / 6) % 2 == 0 { 2.0 } else { -2.0 };
+        mouse = mouse.then(PointerAction::MoveBy {
+            duration: Some(Duration::from_millis(16)),
+            x: dx,
+            y: 1.0 - (step % 2) as f64 * 2.0,
+        });
+    }
+    mouse = mouse
+        .then(PointerAction::MoveBy {
+            duration: Some(Duration::from_millis(16)),
+            x: 6.0,
+            y: 0.0,
+        })
+        .then(PointerAction::Up {
+            button: MOUSE_BUTTON_LEFT,
+        });
+    client
+        .perform_actions(mouse)
+        .await
+        .map_err(|e| e.to_string())?;
+    settle(client).await;
+    let after = server_point(running, layer, point);
+    assert!(
+        after.0 > before.0 + 1.0,
+        "the drag moved {name}'s point ({layer}, {point}) to the right: {before:?} to {after:?}"
+    );
+    let latency = js(
+        client,
+        "const l = window.gradmesh.latency; return [l.samples, l.moves.length, l.inFlight.length];",
+    )
+    .await;
+    let mut samples: Vec<f64> = latency[0]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(latency[1], json!(0), "moves not sent");
+    assert_eq!(latency[2], json!(0), "moves not answered");
+    assert!(
+        samples.len() >= moves / 4,
+        "{} of {moves} moves measured",
+        samples.len()
+    );
+    assert!(samples.iter().all(|t| t.is_finite() && *t >= 0.0));
+    samples.sort_by(f64::total_cmp);
+    let rank = |q: f64| samples[((samples.len() - 1) as f64 * q).round() as usize];
+    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    println!(
+        "browser drag latency, {name} ({layer}, {point}) at 1024 px: {} moves, median {:.1} ms, \
+         95th {:.1} ms, worst {:.1} ms (load {})",
+        samples.len(),
+        rank(0.5),
+        rank(0.95),
+        samples[samples.len() - 1],
+        load.split_whitespace().next().unwrap_or("?")
+    );
+    Ok(())
+}
+
+/// Point `point` of layer `layer` in the server's document.
+fn server_point(running: &Running, layer: usize, point: usize) -> (f64, f64) {
+    let editor = running.app.editor();
+    let p = editor.history.current().doc.layers[layer].points[point].position;
+    (p.x, p.y)
+}
+
+/// The screen position (viewport pixels) of point `point` of layer `layer`.
+async fn point_on_layer(client: &Client, layer: usize, point: usize) -> (f64, f64) {
+    let at = js(
+        client,
+        &format!(
+            "const g = window.gradmesh; const [x, y] = g.toScreen(...g.state.layers[{layer}].points[{point}]); \
+             const r = document.getElementById('overlay').getBoundingClientRect(); \
+             return [r.left + x, r.top + y];"
+        ),
+    )
+    .await;
+    (at[0].as_f64().unwrap(), at[1].as_f64().unwrap())
 }

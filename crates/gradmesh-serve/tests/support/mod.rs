@@ -123,14 +123,15 @@ pub async fn js(client: &Client, script: &str) -> Value {
         .unwrap_or_else(|e| panic!("script failed: {e}\n{script}"))
 }
 
-/// Waits until the page has its state and a frame, and nothing is out or waiting.
+/// Waits until the page has its state and a frame, nothing is out or waiting, and the overlay
+/// is drawn.
 pub async fn settle(client: &Client) {
     let deadline = Instant::now() + Duration::from_secs(30);
     loop {
         let ready = js(
             client,
             "const g = window.gradmesh; return !!g && g.state !== null && g.framesReceived > 0 \
-             && !g.busy && g.pending.length === 0;",
+             && !g.busy && g.pending.length === 0 && !g.overlayQueued;",
         )
         .await;
         if ready == json!(true) {
