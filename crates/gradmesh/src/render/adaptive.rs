@@ -177,40 +177,35 @@ impl TessellationCache {
 }
 
 /// The triangles a tessellation drew: each face's count after balancing, the colour bounds
-/// quadratic triangles were clamped to, and the triangles of each block of
-/// [`FACES_PER_BLOCK`] faces.
+/// quadratic triangles were clamped to, the triangles of each block of [`FACES_PER_BLOCK`]
+/// faces, and where each face's triangles start in its block.
 struct TriangleBlocks {
     counts: Vec<usize>,
     bounds: Option<Bounds>,
     blocks: Vec<Block>,
+    face_starts: Vec<u32>,
 }
 
 /// The triangles of a block of faces, shared by the preparations that keep them.
 type Block = Arc<Vec<Triangle>>;
 
-/// Faces whose triangles are built (and kept) together, in face order: a fixed number, so
-/// that the blocks of two preparations of a layer match. Small, because an edit builds every
-/// block it reaches again; a render from scratch does not depend on the block size.
+/// Faces whose triangles are kept together, in face order: a fixed number, so that the blocks
+/// of two preparations of a layer match. Small, because a block an edit reaches is copied
+/// (its faces the edit left alone) and compared with the last one triangle by triangle; a
+/// render from scratch does not depend on the block size.
 const FACES_PER_BLOCK: usize = 16;
 
-/// Which blocks of `per_block` faces (in face order) must build their triangles again: those
-/// with a face that shares a vertex with a face that did not keep its plan (`kept`), or whose
-/// count after balancing changed (from `last` to `now`). The triangles of a face depend only
-/// on the plans of the faces sharing a vertex with it (their samples along its sides and at
-/// its corners, and the counts of its edges).
-fn blocks_to_build(
-    t: &Topology,
-    kept: &[bool],
-    now: &[usize],
-    last: &[usize],
-    per_block: usize,
-) -> Vec<bool> {
-    let mut build = vec![false; t.face_count().div_ceil(per_block)];
+/// Which faces must build their triangles again: those that share a vertex with a face that
+/// did not keep its plan (`kept`), or whose count after balancing changed (from `last` to
+/// `now`). The triangles of a face depend only on the plans of the faces sharing a vertex with
+/// it (their samples along its sides and at its corners, and the counts of its edges).
+fn faces_to_build(t: &Topology, kept: &[bool], now: &[usize], last: &[usize]) -> Vec<bool> {
+    let mut build = vec![false; t.face_count()];
     for g in 0..t.face_count() {
         if !kept[g] || now[g] != last[g] {
             for &u in t.face_vertices(g) {
                 for &h in t.vertex_faces(u as usize) {
-                    build[h as usize / per_block] = true;
+                    build[h as usize] = true;
                 }
             }
         }
@@ -310,15 +305,16 @@ pub(super) fn tessellate(
         .zip(counts.as_ref())
         .filter(|(last, _)| last.fits(nf, bounds.as_ref()))
         .map(|(last, counts)| {
-            let build = blocks_to_build(t, &faces.reused, counts, &last.counts, FACES_PER_BLOCK);
-            (last.blocks, build)
+            let build = faces_to_build(t, &faces.reused, counts, &last.counts);
+            (last, build)
         });
-    let triangle_blocks = build_blocks(&stitching, nf, last_blocks);
+    let (triangle_blocks, face_starts) = build_blocks(&stitching, nf, last_blocks);
     if let (Some(cache), Some(counts)) = (cache, counts) {
         cache.triangles = Some(TriangleBlocks {
             counts,
             bounds,
             blocks: triangle_blocks.clone(),
+            face_starts,
         });
     }
     let segments = stitching.boundary_segments();
@@ -385,27 +381,65 @@ impl TriangleBlocks {
 
 /// The triangles of `nf` faces, a list per block of [`FACES_PER_BLOCK`] (a list per face,
 /// sized for all its cells' triangles, cost a fresh allocation per face, and most of a dense
-/// layer's triangles are culled). A face draws as last time if every face sharing a vertex
-/// with it kept its plan and its count (its grid and nodes then come out the same), under the
-/// same colour bounds: `last` has the blocks of faces that all do, and which to build again.
+/// layer's triangles are culled), and where each face's triangles start in its block. A face
+/// draws as last time if every face sharing a vertex with it kept its plan and its count (its
+/// grid and nodes then come out the same), under the same colour bounds: `last` has the
+/// triangles of faces that all do, and which faces to build again. A block none of whose
+/// faces is built again is shared whole; in another, the faces not built again copy their
+/// triangles from the last block.
 fn build_blocks(
     stitching: &Stitching<'_>,
     nf: usize,
-    last: Option<(Vec<Block>, Vec<bool>)>,
-) -> Vec<Block> {
-    (0..nf.div_ceil(FACES_PER_BLOCK))
+    last: Option<(TriangleBlocks, Vec<bool>)>,
+) -> (Vec<Block>, Vec<u32>) {
+    let built: Vec<(Block, Vec<u32>)> = (0..nf.div_ceil(FACES_PER_BLOCK))
         .into_par_iter()
-        .map(|b| match &last {
-            Some((last, build)) if !build[b] => Arc::clone(&last[b]),
-            _ => {
-                let mut out = Vec::new();
-                for f in b * FACES_PER_BLOCK..((b + 1) * FACES_PER_BLOCK).min(nf) {
-                    stitching.face_triangles(&mut out, f);
+        .map(|b| {
+            let faces = b * FACES_PER_BLOCK..((b + 1) * FACES_PER_BLOCK).min(nf);
+            if let Some((last, build)) = &last {
+                if !build[faces.clone()].contains(&true) {
+                    let starts = last.face_starts[faces].to_vec();
+                    return (Arc::clone(&last.blocks[b]), starts);
                 }
-                Arc::new(out)
             }
+            let mut out = Vec::new();
+            let mut starts = Vec::with_capacity(faces.len());
+            for f in faces {
+                starts.push(out.len() as u32);
+                match &last {
+                    Some((last, build)) if !build[f] => {
+                        out.extend_from_slice(last.face_triangles(b, f))
+                    }
+                    _ => stitching.face_triangles(&mut out, f),
+                }
+            }
+            (Arc::new(out), starts)
         })
-        .collect()
+        .collect();
+    let mut face_starts = Vec::with_capacity(nf);
+    let blocks = built
+        .into_iter()
+        .map(|(block, starts)| {
+            face_starts.extend(starts);
+            block
+        })
+        .collect();
+    (blocks, face_starts)
+}
+
+impl TriangleBlocks {
+    /// The triangles face `f` drew, in its block `b`.
+    fn face_triangles(&self, b: usize, f: usize) -> &[Triangle] {
+        let block = &self.blocks[b];
+        let start = self.face_starts[f] as usize;
+        let end = match f + 1 {
+            next if next < self.face_starts.len() && next % FACES_PER_BLOCK != 0 => {
+                self.face_starts[next] as usize
+            }
+            _ => block.len(),
+        };
+        &block[start..end]
+    }
 }
 
 /// The figures of a tessellation over its faces.
@@ -749,10 +783,10 @@ mod tests {
         assert_eq!(other.reused_plans, 0);
     }
 
-    /// A block builds its triangles again when a face sharing a vertex with one of its faces
-    /// planned again or changed its count, and not otherwise.
+    /// A face builds its triangles again when a face sharing a vertex with it planned again or
+    /// changed its count, and not otherwise.
     #[test]
-    fn blocks_build_again_around_faces_whose_plans_or_counts_changed() {
+    fn faces_build_again_around_faces_whose_plans_or_counts_changed() {
         // A strip of three quads: the first and the last share no vertex.
         let t = Topology::build(
             8,
@@ -761,15 +795,12 @@ mod tests {
             |_, _| false,
         )
         .unwrap();
-        let build = |kept: [bool; 3], now: [usize; 3], per_block: usize| {
-            blocks_to_build(&t, &kept, &now, &[2, 2, 2], per_block)
-        };
-        assert_eq!(build([true; 3], [2; 3], 1), [false; 3]);
-        assert_eq!(build([true; 3], [2, 4, 2], 1), [true; 3]);
-        assert_eq!(build([true; 3], [4, 2, 2], 1), [true, true, false]);
-        assert_eq!(build([true, true, false], [2; 3], 1), [false, true, true]);
-        assert_eq!(build([true; 3], [4, 2, 2], 2), [true, false]);
-        assert_eq!(build([true; 3], [2, 2, 1], 2), [true, true]);
+        let build = |kept: [bool; 3], now: [usize; 3]| faces_to_build(&t, &kept, &now, &[2, 2, 2]);
+        assert_eq!(build([true; 3], [2; 3]), [false; 3]);
+        assert_eq!(build([true; 3], [2, 4, 2]), [true; 3]);
+        assert_eq!(build([true; 3], [4, 2, 2]), [true, true, false]);
+        assert_eq!(build([true, true, false], [2; 3]), [false, true, true]);
+        assert_eq!(build([true; 3], [2, 2, 1]), [false, true, true]);
     }
 
     /// Pixel coverage counts of a tessellation.
