@@ -12,7 +12,7 @@
 //! per artwork and edit, the median, 95th percentile and worst of 100 steps, and for the drag
 //! the time of each stage of one step. `GRADMESH_LATENCY_STEPS=N` sets the steps,
 //! `GRADMESH_LATENCY_ARTWORKS=glasses,tucan` the artworks; a criterion filter (`-- drag`) runs
-//! criterion alone.
+//! criterion alone; `GRADMESH_LATENCY_DRAG=3,28` times that drag alone.
 
 #![allow(missing_docs)] // criterion_group! generates undocumented items.
 
@@ -333,8 +333,31 @@ fn edit_latency(c: &mut Criterion) {
 
 criterion_group!(benches, edit_latency);
 
+/// The drag named by `GRADMESH_LATENCY_DRAG=LAYER,POINT`, if any: the reports then profile
+/// that drag alone (for `perf record`), without searching for the costliest points.
+fn named_drag() -> Option<(usize, usize)> {
+    let text = std::env::var("GRADMESH_LATENCY_DRAG").ok()?;
+    let (layer, point) = text.split_once(',')?;
+    Some((layer.trim().parse().ok()?, point.trim().parse().ok()?))
+}
+
 fn main() {
     let criterion_only = std::env::args().skip(1).any(|a| !a.starts_with('-'));
+    if let Some((layer, point)) = named_drag() {
+        for (name, files) in chosen() {
+            let doc = artwork(files);
+            let opts = options(&doc);
+            let pixel = opts.view.width() / opts.width as f64;
+            let t = Target {
+                layer,
+                point,
+                pixel,
+            };
+            report(name, "drag", &doc, t, drag_command);
+            profile_drag(name, &doc, t);
+        }
+        return;
+    }
     if !criterion_only {
         for (name, files) in chosen() {
             let doc = artwork(files);

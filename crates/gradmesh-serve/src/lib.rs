@@ -30,6 +30,8 @@ use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use axum::serve::ListenerExt;
+
 pub use editor::{Editor, History};
 pub use ops::{Op, Picture};
 pub use session::{App, Command, Outgoing, Session};
@@ -144,6 +146,12 @@ pub async fn start(config: &Config) -> Result<Running, String> {
     };
     let token = gate.token.clone();
     let router = server::router(Arc::clone(&app), gate);
+    // Without Nagle's algorithm: a frame's state and "done" are small messages right after a
+    // large one, which would wait for the page's delayed acknowledgement (tens of milliseconds).
+    let listener = listener.tap_io(|stream| {
+        // The connection works without it, only slower.
+        let _ = stream.set_nodelay(true);
+    });
     let task = tokio::spawn(async move { axum::serve(listener, router).await });
     Ok(Running {
         address,
