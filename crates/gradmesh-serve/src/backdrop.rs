@@ -19,7 +19,7 @@ use crate::viewer::Viewport;
 pub const MAX_BACKDROP_MEMORY: u64 = 1 << 30;
 
 /// What an SVG or PDF file holds besides the layers read from it.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Backdrop {
     /// The file (its relative links are resolved against its folder).
     pub path: PathBuf,

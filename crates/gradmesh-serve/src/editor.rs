@@ -5,7 +5,6 @@ use std::path::{Path, PathBuf};
 use gradmesh::formats::{self, Format};
 use gradmesh::{ColourSpace, Document, GradientMesh};
 
-use crate::backdrop::Backdrop;
 use crate::ops::{Applied, Op, Picture};
 
 /// Undo and redo steps kept at most.
@@ -188,15 +187,15 @@ impl Editor {
         }
     }
 
-    /// The document in the file at `path`, and an SVG file's backdrop
+    /// The document in the file at `path`, with an SVG or PDF file's backdrop
     /// ([`crate::backdrop::read_document`]).
-    pub fn open(path: &Path) -> Result<(Editor, Option<Backdrop>), String> {
+    pub fn open(path: &Path) -> Result<Editor, String> {
         let read = crate::backdrop::read_document(path)?;
-        let editor = Editor {
-            history: History::new(Picture::new(read.document)),
+        let picture = Picture::new(read.document).with_backdrop(read.backdrop);
+        Ok(Editor {
+            history: History::new(picture),
             path: Some(save_path_for(path)),
-        };
-        Ok((editor, read.backdrop))
+        })
     }
 
     /// Writes the document as JSON to `path` (atomically) and makes it the file "save" writes.

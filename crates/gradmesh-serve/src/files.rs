@@ -133,7 +133,9 @@ impl FileState {
         self.generation += 1;
         if restore {
             let doc = self.recovery.take_found().expect("pending");
-            editor.history.replace(Picture::new(doc))
+            let mut picture = Picture::new(doc);
+            picture.backdrops = editor.history.current().backdrops.clone();
+            editor.history.replace(picture)
         } else {
             self.recovery.discard_found()
         }
@@ -198,25 +200,18 @@ pub fn read_layers(path: &Path) -> Result<(Vec<GradientMesh>, Option<Backdrop>),
 }
 
 /// Adds the layers of the document `name` (a file of the folder, any format gradmesh reads)
-/// above the layers of `editor`'s document, as one step of the history; an SVG file's backdrop
-/// goes above the `backdrops` (it stays when the import is undone).
-pub fn import_layers(
-    folder: &Folder,
-    editor: &mut Editor,
-    backdrops: &mut Vec<Backdrop>,
-    name: &str,
-) -> Result<(), String> {
+/// above the layers of `editor`'s document, with an SVG or PDF file's backdrop above the
+/// picture's backdrops, as one step of the history (undo takes both away).
+pub fn import_layers(folder: &Folder, editor: &mut Editor, name: &str) -> Result<(), String> {
     let path = folder.resolve(name)?;
     let (layers, backdrop) = read_layers(&path)?;
     if layers.is_empty() {
         return Err(format!("{name} has no layers"));
     }
-    let mut next = editor.history.current().clone();
+    let mut next = editor.history.current().clone().with_backdrop(backdrop);
     next.hidden.extend(layers.iter().map(|_| false));
     next.doc.layers.extend(layers);
-    editor.history.replace(next)?;
-    backdrops.extend(backdrop);
-    Ok(())
+    editor.history.replace(next)
 }
 
 /// Adds what the page shows of the files to the state message `state`: `saved` (the file and

@@ -85,11 +85,9 @@ pub fn open_app(config: &Config) -> Result<Arc<App>, String> {
     };
     let folder = Folder::new(&folder_path)
         .map_err(|e| format!("cannot use the folder {}: {e}", folder_path.display()))?;
-    let mut backdrops = Vec::new();
     let (mut editor, mut source) = match &config.file {
         Some(file) => {
-            let (mut editor, backdrop) = Editor::open(file)?;
-            backdrops.extend(backdrop);
+            let mut editor = Editor::open(file)?;
             // "save" writes inside the folder only.
             if let Some(path) = &editor.path {
                 let name = path.file_name().map(|n| n.to_string_lossy().to_string());
@@ -105,7 +103,7 @@ pub fn open_app(config: &Config) -> Result<Arc<App>, String> {
         for file in &config.layers_above {
             let (layers, backdrop) =
                 files::read_layers(file).map_err(|e| format!("{}: {e}", file.display()))?;
-            backdrops.extend(backdrop);
+            picture = picture.with_backdrop(backdrop);
             picture.hidden.extend(layers.iter().map(|_| false));
             picture.doc.layers.extend(layers);
         }
@@ -123,7 +121,6 @@ pub fn open_app(config: &Config) -> Result<Arc<App>, String> {
         key.push_str(&file.display().to_string());
     }
     let app = App::new(editor, folder);
-    *app.backdrops() = backdrops;
     let editor = app.editor();
     let warning = app.files().opened(source.as_deref(), &editor, &key);
     drop(editor);

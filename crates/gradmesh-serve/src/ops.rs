@@ -10,23 +10,41 @@ use gradmesh::{
 };
 use kurbo::{Point, Vec2};
 use serde::Deserialize;
+use std::sync::Arc;
 
+use crate::backdrop::Backdrop;
 use crate::tools::{self, remove_faces_and_points, Selection, ToolResult};
 
-/// What the editor shows: the document and, per layer, whether it is hidden.
+/// What the editor shows: the document, per layer whether it is hidden, and what the SVG or
+/// PDF files it came from hold besides (their backdrops, part of the picture so that undoing
+/// an import takes its backdrop away too).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Picture {
     /// The document.
     pub doc: Document,
     /// Per layer: hidden (not drawn, still saved).
     pub hidden: Vec<bool>,
+    /// The backdrops, bottom first (shared between the steps of the history).
+    pub backdrops: Arc<Vec<Backdrop>>,
 }
 
 impl Picture {
-    /// A picture of `doc` with every layer shown.
+    /// A picture of `doc` with every layer shown, without backdrops.
     pub fn new(doc: Document) -> Picture {
         let hidden = vec![false; doc.layers.len()];
-        Picture { doc, hidden }
+        Picture {
+            doc,
+            hidden,
+            backdrops: Arc::default(),
+        }
+    }
+
+    /// This picture with `backdrop`, if any, above its backdrops.
+    pub fn with_backdrop(mut self, backdrop: Option<Backdrop>) -> Picture {
+        if let Some(backdrop) = backdrop {
+            Arc::make_mut(&mut self.backdrops).push(backdrop);
+        }
+        self
     }
 
     /// The document of the layers shown.

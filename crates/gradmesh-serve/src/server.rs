@@ -219,7 +219,7 @@ async fn backdrop_png(State(app): State<Arc<App>>, Query(q): Query<BackdropQuery
     if let Err(e) = viewport.check() {
         return (StatusCode::BAD_REQUEST, e).into_response();
     }
-    let backdrops = app.backdrops().clone();
+    let backdrops = app.editor().history.current().backdrops.clone();
     let png = tokio::task::spawn_blocking(move || -> Result<Option<Vec<u8>>, String> {
         let Some(rgba) = crate::backdrop::render(&backdrops, &viewport)? else {
             return Ok(None);

@@ -6,7 +6,7 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use gradmesh::render::View;
 use serde::Deserialize;
 
-use crate::backdrop::{self, Backdrop};
+use crate::backdrop;
 use crate::clipboard;
 use crate::editor::Editor;
 use crate::files::{self, FileState, Refusal};
@@ -25,8 +25,6 @@ pub struct App {
     pub folder: Folder,
     /// What the session wrote and saved ([`files`]).
     pub files: Mutex<FileState>,
-    /// What the SVG files opened draw besides their mesh fills, bottom first.
-    pub backdrops: Mutex<Vec<Backdrop>>,
 }
 
 impl App {
@@ -36,13 +34,7 @@ impl App {
             editor: Mutex::new(editor),
             folder,
             files: Mutex::new(FileState::default()),
-            backdrops: Mutex::new(Vec::new()),
         }
-    }
-
-    /// The backdrops (locked after [`App::editor`] when both are held).
-    pub fn backdrops(&self) -> MutexGuard<'_, Vec<Backdrop>> {
-        self.backdrops.lock().unwrap_or_else(|e| e.into_inner())
     }
 
     /// What the session wrote and saved (locked after [`App::editor`] when both are held).
@@ -269,7 +261,7 @@ impl Session {
         self.told_version = Some(key);
         let mut state = status.to_json();
         files::describe(&files, &mut state);
-        state["backdrops"] = backdrop::describe(&app.backdrops(), |p| app.folder.name_of(p));
+        state["backdrops"] = backdrop::describe(&h.current().backdrops, |p| app.folder.name_of(p));
         Some(state.to_string())
     }
 
@@ -338,9 +330,7 @@ impl Session {
             }
             Command::Open { name } => {
                 let path = app.folder.resolve(name)?;
-                let (opened, backdrop) = Editor::open(&path)?;
-                *editor = opened;
-                *app.backdrops() = backdrop.into_iter().collect();
+                *editor = Editor::open(&path)?;
                 let key = app.folder.root().join(name).display().to_string();
                 note = app.files().opened(Some(&path), &editor, &key);
                 self.told_version = None;
@@ -348,16 +338,13 @@ impl Session {
             }
             Command::New => {
                 *editor = Editor::new_document();
-                app.backdrops().clear();
                 let key = app.folder.root().display().to_string();
                 note = app.files().opened(None, &editor, &key);
                 self.told_version = None;
                 Ok(())
             }
             Command::Recovery { restore } => app.files().choose_recovery(&mut editor, *restore),
-            Command::ImportLayers { name } => {
-                files::import_layers(&app.folder, &mut editor, &mut app.backdrops(), name)
-            }
+            Command::ImportLayers { name } => files::import_layers(&app.folder, &mut editor, name),
             Command::Paste {
                 from_layer,
                 faces,

@@ -408,3 +408,57 @@ async fn a_pdf_without_a_patch_mesh_shading_is_refused_with_its_reason() {
         "{message}"
     );
 }
+
+/// A mesh gradient over a blue square: the square is the SVG file's backdrop.
+const SQUARE_BEHIND_A_MESH: &str = r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200" viewBox="0 0 200 200">
+  <meshgradient id="m" gradientUnits="userSpaceOnUse" x="50" y="50">
+    <meshrow>
+      <meshpatch>
+        <stop path="l 100,0" stop-color="#ff4040"/>
+        <stop path="l 0,100" stop-color="#ffe060"/>
+        <stop path="l -100,0" stop-color="#40a0ff"/>
+        <stop path="l 0,-100" stop-color="#8040c0"/>
+      </meshpatch>
+    </meshrow>
+  </meshgradient>
+  <rect x="10" y="10" width="180" height="180" fill="#1a2a5a"/>
+  <rect x="50" y="50" width="100" height="100" fill="url(#m)"/>
+</svg>"##;
+
+/// An imported SVG file's backdrop is part of the import's step: undo takes it away with the
+/// layers, redo brings it back.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn undoing_an_import_takes_its_backdrop_away() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("drawing.svg"), SQUARE_BEHIND_A_MESH).unwrap();
+    let running = serve(None, dir.path()).await;
+    let view = "/api/backdrop.png?width=64&height=64&x0=0&y0=0&x1=200&y1=200";
+    let (_, state) = command(&running, r#"{"type":"state"}"#).await;
+    let layers = state["layers"].as_array().unwrap().len();
+    assert_eq!(state["backdrops"].as_array().unwrap().len(), 0, "{state}");
+    assert_eq!(get(&running, view).await.0, 204, "no backdrop yet");
+
+    let (status, state) =
+        command(&running, r#"{"type":"import_layers","name":"drawing.svg"}"#).await;
+    assert_eq!(status, 200, "{state}");
+    assert_eq!(state["layers"].as_array().unwrap().len(), layers + 1);
+    let backdrops = state["backdrops"].as_array().unwrap();
+    assert_eq!(backdrops.len(), 1, "{state}");
+    assert_eq!(backdrops[0]["drawn"], true);
+    assert_eq!(get(&running, view).await.0, 200, "the square is drawn");
+
+    let (status, state) = command(&running, r#"{"type":"undo"}"#).await;
+    assert_eq!(status, 200, "{state}");
+    assert_eq!(state["layers"].as_array().unwrap().len(), layers);
+    assert_eq!(state["backdrops"].as_array().unwrap().len(), 0, "{state}");
+    assert_eq!(
+        get(&running, view).await.0,
+        204,
+        "undo took the backdrop away"
+    );
+
+    let (status, state) = command(&running, r#"{"type":"redo"}"#).await;
+    assert_eq!(status, 200, "{state}");
+    assert_eq!(state["backdrops"].as_array().unwrap().len(), 1, "{state}");
+    assert_eq!(get(&running, view).await.0, 200, "redo brought it back");
+}
