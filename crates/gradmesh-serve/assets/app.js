@@ -573,7 +573,10 @@ overlay.addEventListener("pointerdown", (event) => {
   drawOverlay();
 });
 
-overlay.addEventListener("pointermove", (event) => {
+// Moves as they arrive: Chromium holds `pointermove` back to the next animation frame (up to
+// 16 ms), `pointerrawupdate` (where there is one) is dispatched at once.
+const moveEvent = "onpointerrawupdate" in window ? "pointerrawupdate" : "pointermove";
+overlay.addEventListener(moveEvent, (event) => {
   if (editor.tools && editor.tools.pointerMove(event, eventPosition(event))) return;
   if (!editor.drag) return;
   // The event's time is when the input arrived, so the wait for the page's turn counts too.
