@@ -272,6 +272,11 @@ pub struct ConvertArgs {
     /// Allow the output to be the input file itself.
     #[arg(long)]
     pub force: bool,
+    /// Fit each layer's control colours, and refined-level colour edits where they do not
+    /// suffice, by least squares to the classic painting of the mesh gradient (SVG) or
+    /// patch-mesh shading (PDF) it came from, so that the scheme looks as the file does.
+    #[arg(long)]
+    pub fit: bool,
     /// The paper's options.
     #[command(flatten)]
     pub variant: VariantArgs,

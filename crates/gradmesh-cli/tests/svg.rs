@@ -599,3 +599,53 @@ fn the_draft_mesh_element_draws_the_rest_of_the_picture() {
         .count();
     assert!(ellipse > 10_000, "{ellipse} pixels of the ellipse");
 }
+
+/// `convert --fit` writes the layers with their colours fitted to the file's classic painting,
+/// with refined-level colour edits; a file without classic meshes is refused, nothing written.
+#[test]
+fn convert_fit_fits_the_colours_and_refuses_other_inputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let svg = sample("sample6.svg");
+    let (plain, fitted) = (
+        dir.path().join("plain.json"),
+        dir.path().join("fitted.json"),
+    );
+    for (json, fit) in [(&plain, false), (&fitted, true)] {
+        let mut args = vec![
+            "convert",
+            svg.to_str().unwrap(),
+            "-o",
+            json.to_str().unwrap(),
+        ];
+        if fit {
+            args.push("--fit");
+        }
+        let out = gradmesh(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let (plain, fitted_text) = (
+        std::fs::read_to_string(&plain).unwrap(),
+        std::fs::read_to_string(&fitted).unwrap(),
+    );
+    assert!(!plain.contains("\"edits\""), "{plain}");
+    assert!(fitted_text.contains("\"edits\""), "no edits written");
+    let again = dir.path().join("again.json");
+    let out = gradmesh(&[
+        "convert",
+        fitted.to_str().unwrap(),
+        "-o",
+        again.to_str().unwrap(),
+        "--fit",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("--fit needs an SVG or PDF input"),
+        "{stderr}"
+    );
+    assert!(!again.exists());
+}

@@ -35,6 +35,7 @@
 
 mod binary_step;
 mod catmull_clark;
+mod classic_fit;
 mod colour;
 mod edit_check;
 mod edits;
@@ -60,12 +61,14 @@ mod union_find;
 mod validate;
 mod view;
 
+pub use classic_fit::{fit_to_classic, ClassicFitOptions};
 pub use colour::{parse_css_colour, ColourSpace};
 pub use edit_check::EditSet;
 pub use error::{Error, ErrorKind, Location, Result, Warning, WarningKind};
 pub use fit::{
-    fit_colours, psnr, vectorise, vectorise_with_progress, Progress, Quality, RgbaImage,
-    VectoriseOptions, Vectorised, MAX_IMAGE_BYTES, MAX_IMAGE_PIXELS,
+    fit_colours, fit_colours_with_detail, psnr, vectorise, vectorise_with_progress, DetailFit,
+    DetailOptions, Progress, Quality, RgbaImage, VectoriseOptions, Vectorised, MAX_IMAGE_BYTES,
+    MAX_IMAGE_PIXELS,
 };
 pub use join::{join_meshes, JoinTolerance, Joined};
 pub use limit_matrix::{limit_matrix, LimitMatrix};

@@ -14,6 +14,7 @@
 //! ([`geometry`]), the colours solved again after each, while the error falls and the surface
 //! stays free of folds.
 
+mod detail;
 mod geometry;
 mod image;
 mod quadtree;
@@ -34,8 +35,11 @@ use crate::size_limits::Limits;
 
 pub use image::{psnr, RgbaImage, MAX_IMAGE_BYTES, MAX_IMAGE_PIXELS};
 
+pub use detail::{fit_colours_with_detail, DetailFit, DetailOptions};
 use image::{psnr_of_sum, Target};
 use quadtree::{Key, Quadtree};
+
+use detail::DetailEdits;
 use raster::Observation;
 use rows::SparseRows;
 use solve::NormalEquations;
@@ -177,6 +181,9 @@ struct FitSettings {
     smoothness: f64,
     tolerance: f64,
     max_iterations: usize,
+    /// The weight of the offsets of refined-level edits, relative to the average weight a
+    /// control point gets from its pixels.
+    ridge: f64,
 }
 
 /// The sampling level: the deepest (2 to 6) whose faces number at most `faces_per_pixel` per
@@ -228,11 +235,25 @@ fn fit_mesh(
     mesh: &GradientMesh,
     target: &Target,
     settings: &FitSettings,
-    mut colours: Vec<[f64; 3]>,
+    colours: Vec<[f64; 3]>,
 ) -> Result<Fitted, Error> {
-    let pixels = target.width * target.height;
-    let depth = sampling_level(mesh, pixels, settings.faces_per_pixel);
-    let (refinement, _) = Refinement::new_with_limits(mesh, depth, &Limits::DEFAULT)?;
+    let refinement = |depth| Refinement::new_with_limits(mesh, depth, &Limits::DEFAULT);
+    let depth = sampling_level(mesh, target.width * target.height, settings.faces_per_pixel);
+    let (refinement, _) = refinement(depth)?;
+    fit_refined(mesh, &refinement, target, settings, colours, None)
+}
+
+/// [`fit_mesh`] on the levels of `refinement` (sampled at its deepest level), with the
+/// offsets of `detail` as unknowns after the control colours (`colours` holds both).
+fn fit_refined(
+    mesh: &GradientMesh,
+    refinement: &Refinement,
+    target: &Target,
+    settings: &FitSettings,
+    mut colours: Vec<[f64; 3]>,
+    detail: Option<&DetailEdits>,
+) -> Result<Fitted, Error> {
+    let depth = refinement.depth();
     let data = refinement.evaluate_to(refinement.base(), depth);
     let limit = limit_stencils(refinement.level(depth)).expect("levels from 2 on are quads");
     let positions: Vec<[f64; 2]> = limit
@@ -241,18 +262,25 @@ fn fit_mesh(
         .map(|d| [d[0], d[1]])
         .collect();
     drop(data);
-    let rows = rows::limit_colour_rows(&refinement, depth, &limit, mesh.points.len());
-    let observation = Observation::new(&refinement, depth, &positions, target);
+    let points = mesh.points.len();
+    let rows = match detail {
+        Some(d) => d.limit_colour_rows(refinement, depth, &limit, points),
+        None => rows::limit_colour_rows(refinement, depth, &limit, points),
+    };
+    let observation = Observation::new(refinement, depth, &positions, target);
     let edges = mesh_edges(mesh);
     let mut equations = NormalEquations {
         rows: &rows,
         observation: &observation,
         edges: &edges,
         lambda: 0.0,
+        ridge: 0.0,
+        ridge_from: points,
     };
     let diagonal = equations.diagonal();
-    let mean = diagonal.iter().sum::<f64>() / diagonal.len().max(1) as f64;
+    let mean = diagonal[..points].iter().sum::<f64>() / points.max(1) as f64;
     equations.lambda = settings.smoothness * mean;
+    equations.ridge = settings.ridge * mean;
     equations.solve(&mut colours, settings.tolerance, settings.max_iterations);
     let vertex_colours = rows.apply(&colours);
     Ok(Fitted {
@@ -279,6 +307,7 @@ pub fn fit_colours(
         smoothness: 0.0,
         tolerance: 1e-10,
         max_iterations: 20 * quality.max_iterations(),
+        ridge: 0.0,
     };
     let guess = mesh.points.iter().map(|p| p.colour).collect();
     let fitted = fit_mesh(mesh, &target, &settings, guess)?;
@@ -287,11 +316,16 @@ pub fn fit_colours(
         p.colour_text = None;
     }
     let errors = pixel_errors(&fitted, &target, image, mesh.colour_space);
+    Ok(psnr_of_covered(&errors))
+}
+
+/// PSNR of [`pixel_errors`] over the pixels the surface covers.
+fn psnr_of_covered(errors: &[Option<f64>]) -> f64 {
     let (sum, count) = errors
         .iter()
         .flatten()
         .fold((0.0, 0), |(s, n), &e| (s + e, n + 3));
-    Ok(psnr_of_sum(sum, count.max(1)))
+    psnr_of_sum(sum, count.max(1))
 }
 
 /// Per pixel, the squared 8-bit sRGB error summed over the channels of what the fitted surface
@@ -352,6 +386,7 @@ pub fn vectorise_with_progress(
         smoothness: options.smoothness,
         tolerance: 1e-4,
         max_iterations: quality.max_iterations(),
+        ridge: 0.0,
     };
     let min_px = options.min_cell_px.max(0.5);
     // A quarter of a point budget; few points when only a PSNR is asked for.
@@ -719,6 +754,7 @@ mod tests {
             smoothness: 0.0,
             tolerance: 1e-13,
             max_iterations: 5000,
+            ridge: 0.0,
         };
         let truth: Vec<[f64; 3]> = mesh.points.iter().map(|p| p.colour).collect();
         // The picture: what the fit's sampling shows of the true colours (no solver step).

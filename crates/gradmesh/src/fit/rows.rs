@@ -37,6 +37,42 @@ impl SparseRows {
         }
     }
 
+    /// These rows with `columns` unknowns in all (at least as many as now).
+    pub fn widened(mut self, columns: usize) -> SparseRows {
+        self.columns = self.columns.max(columns);
+        self
+    }
+
+    /// The rows with row `i` replaced by `replace(i, cols, vals)` where that gives one (its
+    /// entries' columns increasing).
+    pub fn map_rows(
+        &self,
+        replace: impl Fn(usize, &[u32], &[f64]) -> Option<Vec<(u32, f64)>>,
+    ) -> SparseRows {
+        let mut out = SparseRows {
+            offsets: vec![0],
+            columns: self.columns,
+            ..SparseRows::default()
+        };
+        for i in 0..self.len() {
+            let (cols, vals) = self.row(i);
+            match replace(i, cols, vals) {
+                Some(row) => {
+                    for (c, v) in row {
+                        out.cols.push(c);
+                        out.vals.push(v);
+                    }
+                }
+                None => {
+                    out.cols.extend_from_slice(cols);
+                    out.vals.extend_from_slice(vals);
+                }
+            }
+            out.offsets.push(out.cols.len() as u32);
+        }
+        out
+    }
+
     /// The number of rows.
     pub fn len(&self) -> usize {
         self.offsets.len() - 1
@@ -183,21 +219,26 @@ pub(crate) fn ternary_colour_sources(base: &Topology) -> Vec<u32> {
     sources
 }
 
+/// The colours of level 1 as rows over the control points (`source_point` of the base level
+/// names each base vertex's point), with `columns` unknowns in all (at least `points`).
+pub(crate) fn level_1_rows(refinement: &Refinement, points: usize, columns: usize) -> SparseRows {
+    let base = refinement.base();
+    let sources = ternary_colour_sources(&base.topology)
+        .into_iter()
+        .map(|v| base.source_point[v as usize])
+        .collect();
+    SparseRows::selection(sources, points).widened(columns)
+}
+
 /// The limit colours of the vertices of level `depth >= 2` of `refinement` as rows over the
-/// control points (`source_point` of the base level names each base vertex's point), with
-/// `limit` the level's limit stencils.
+/// control points, with `limit` the level's limit stencils.
 pub(crate) fn limit_colour_rows(
     refinement: &Refinement,
     depth: usize,
     limit: &Stencils,
     points: usize,
 ) -> SparseRows {
-    let base = refinement.base();
-    let sources = ternary_colour_sources(&base.topology)
-        .into_iter()
-        .map(|v| base.source_point[v as usize])
-        .collect();
-    let mut rows = SparseRows::selection(sources, points);
+    let mut rows = level_1_rows(refinement, points, points);
     for k in 1..depth {
         rows = rows.compose(refinement.stencils(k));
     }

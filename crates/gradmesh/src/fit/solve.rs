@@ -21,6 +21,11 @@ pub(crate) struct NormalEquations<'a> {
     pub edges: &'a [[u32; 2]],
     /// The weight of the smoothness term.
     pub lambda: f64,
+    /// The weight of `|x_i|^2` for the unknowns from `ridge_from` on (refined-level offsets,
+    /// kept small where the control colours explain the picture).
+    pub ridge: f64,
+    /// The first unknown the ridge applies to.
+    pub ridge_from: usize,
 }
 
 type Colours = Vec<[f64; 3]>;
@@ -41,6 +46,13 @@ impl NormalEquations<'_> {
                 }
             }
         }
+        if self.ridge > 0.0 {
+            for (o, xi) in out.iter_mut().zip(x).skip(self.ridge_from) {
+                for k in 0..3 {
+                    o[k] += self.ridge * xi[k];
+                }
+            }
+        }
         out
     }
 
@@ -56,6 +68,9 @@ impl NormalEquations<'_> {
         for &[a, b] in self.edges {
             d[a as usize] += self.lambda;
             d[b as usize] += self.lambda;
+        }
+        for v in d.iter_mut().skip(self.ridge_from) {
+            *v += self.ridge;
         }
         d
     }

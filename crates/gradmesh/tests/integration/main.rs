@@ -15,6 +15,7 @@ mod realdata;
 mod accuracy_1024;
 mod binary_step;
 mod cache;
+mod classic_fit;
 mod closed_form;
 mod corpus;
 mod declared_counts;
