@@ -462,3 +462,25 @@ async fn undoing_an_import_takes_its_backdrop_away() {
     assert_eq!(state["backdrops"].as_array().unwrap().len(), 1, "{state}");
     assert_eq!(get(&running, view).await.0, 200, "redo brought it back");
 }
+
+/// The paper authors' Glasses exported as SVG (a mesh gradient per patch, finer patches around
+/// its irregular points meeting coarser ones at T-junctions) opens again as a few layers: the
+/// coarse sides are cut where the finer patches' corners lie, and the rings join the rest.
+#[test]
+fn an_exported_glasses_opens_again_as_a_few_layers() {
+    use gradmesh_serve::exports::{export_document, ExportFormat};
+    let doc = gradmesh::formats::read_path(&shared_off("Glasses.off")).unwrap();
+    let svg = export_document(&doc, ExportFormat::Svg, 512).expect("the SVG export");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("glasses.svg");
+    std::fs::write(&path, svg).unwrap();
+    let gradients = gradmesh::formats::read_path(&path).unwrap().layers.len();
+    let read = gradmesh_serve::backdrop::read_document(&path).unwrap();
+    let layers = read.document.layers.len();
+    assert!(gradients > 5000, "{gradients} mesh gradients");
+    // Joined without cutting sides at T-junctions, they make 190 layers.
+    assert!(
+        layers <= 30,
+        "{gradients} gradients open as {layers} layers"
+    );
+}

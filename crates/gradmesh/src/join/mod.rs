@@ -10,6 +10,8 @@ use crate::mesh::{edge_key, GradientMesh, WedgeOverride};
 use crate::union_find::UnionFind;
 use crate::validate::validate;
 
+mod t_junctions;
+
 /// How close two sides must be to count as one.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct JoinTolerance {
@@ -44,7 +46,31 @@ pub struct Joined {
 /// and carries every member's handles, edge tags, side entries and edits over to the shared
 /// numbering. A set whose joined mesh would not be valid (two sides meeting at a place where
 /// a third also meets, say) stays apart, as do meshes that meet no other.
+///
+/// Before sides are compared, a boundary side with another mesh's boundary corner inside it
+/// (a T-junction: a coarse patch beside two finer ones) is cut there, when the corner's colour
+/// and opacity are the side's own at that place within `tolerance`: the face holding the side
+/// gets the corner as one more point, so that the finer sides meet its parts. Meshes that stay
+/// apart keep their sides uncut. Where the cuts leave more meshes apart than joining without
+/// them (a set made invalid by a folded patch, say), the meshes are joined without cuts.
 pub fn join_meshes(meshes: &[GradientMesh], tolerance: JoinTolerance) -> Vec<Joined> {
+    let cut = t_junctions::split_sides_at_corners(meshes, tolerance);
+    let with_cuts = join_sides(&cut, meshes, tolerance);
+    let without = join_sides(meshes, meshes, tolerance);
+    if with_cuts.len() <= without.len() {
+        with_cuts
+    } else {
+        without
+    }
+}
+
+/// [`join_meshes`] of `meshes` (the `originals`, some sides cut): a set that would not be
+/// valid joined gives its originals.
+fn join_sides(
+    meshes: &[GradientMesh],
+    originals: &[GradientMesh],
+    tolerance: JoinTolerance,
+) -> Vec<Joined> {
     let offsets = point_offsets(meshes);
     let mut points = UnionFind::new(*offsets.last().unwrap_or(&0));
     let mut groups = UnionFind::new(meshes.len());
@@ -67,7 +93,7 @@ pub fn join_meshes(meshes: &[GradientMesh], tolerance: JoinTolerance) -> Vec<Joi
         match joined {
             Some(mesh) => out.push(Joined { mesh, sources }),
             None => out.extend(sources.into_iter().map(|i| Joined {
-                mesh: meshes[i].clone(),
+                mesh: originals[i].clone(),
                 sources: vec![i],
             })),
         }
