@@ -10,13 +10,14 @@ use std::fs;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
-const TARGETS: [&str; 6] = [
+const TARGETS: [&str; 7] = [
     "parse_json",
     "parse_off",
     "parse_obj",
     "parse_svg",
     "pipeline",
     "render",
+    "vectorise",
 ];
 
 fn inputs(dir: &Path) -> Vec<PathBuf> {

@@ -425,7 +425,60 @@ pub fn run_target(target: &str, data: &[u8]) {
         Some(format) => parse(format, data),
         None if target == "pipeline" => pipeline_bytes(data),
         None if target == "render" => render::render_bytes(data),
+        None if target == "vectorise" => vectorise_bytes(data),
         None => panic!("unknown fuzz target {target}"),
+    }
+}
+
+/// The most pixels a picture of [`vectorise_bytes`] may have: a few thousand keep one input
+/// within a fraction of a second.
+pub const FUZZ_IMAGE_PIXELS: u64 = 1 << 12;
+
+/// Decodes `data` as a PNG or JPEG picture (refused beyond [`FUZZ_IMAGE_PIXELS`] before
+/// decoding) and vectorises it with a small budget: an error with a message, or a mesh within
+/// the budget that validates, covers the picture's rectangle and renders back at a PSNR that is
+/// a number.
+pub fn vectorise_bytes(data: &[u8]) {
+    let image = match gradmesh::RgbaImage::decode(data, FUZZ_IMAGE_PIXELS) {
+        Ok(image) => image,
+        Err(e) => {
+            check_error(&e);
+            return;
+        }
+    };
+    assert!(
+        image.width > 0 && image.height > 0,
+        "an empty picture decoded"
+    );
+    let options = gradmesh::VectoriseOptions {
+        points: Some(24),
+        quality: gradmesh::Quality::Fast,
+        ..gradmesh::VectoriseOptions::default()
+    };
+    let out = match gradmesh::vectorise(&image, &options) {
+        Ok(out) => out,
+        Err(e) => {
+            check_error(&e);
+            return;
+        }
+    };
+    assert!(out.points <= 24, "{} points for a budget of 24", out.points);
+    assert!(!out.psnr.is_nan(), "PSNR is not a number");
+    assert_eq!(out.document.layers.len(), 1);
+    let mesh = &out.document.layers[0];
+    gradmesh::validate(mesh).unwrap_or_else(|e| panic!("the vectorised mesh is invalid: {e}"));
+    let (w, h) = (f64::from(image.width), f64::from(image.height));
+    for p in &mesh.points {
+        let q = p.position;
+        assert!(
+            q.x >= -0.01 && q.x <= w + 0.01 && q.y >= -0.01 && q.y <= h + 0.01,
+            "point {q:?} outside the {w} x {h} picture"
+        );
+        assert!(
+            p.colour.iter().all(|c| c.is_finite()),
+            "colour {:?}",
+            p.colour
+        );
     }
 }
 
