@@ -327,3 +327,186 @@ fn inkscape_pdf_converts_into_the_scheme() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A stream object of the dictionary entries `dict` and the data `data`.
+fn pdf_stream(dict: &str, data: &[u8]) -> Vec<u8> {
+    let mut s = format!("<< {dict} /Length {} >>\nstream\n", data.len()).into_bytes();
+    s.extend(data);
+    s.extend(b"\nendstream");
+    s
+}
+
+/// The page entries of a page of 255 x 255 points.
+const SQUARE_PAGE: &str = "/MediaBox [0 0 255 255]";
+
+/// A one-page PDF file whose content paints the shading `dict` (object 5, its stream `data`)
+/// with `sh`; `page_entries` (the boxes, say) are added to the page's dictionary and `more`
+/// objects are numbered from 6. The cross-reference table is correct.
+fn one_shading_pdf(dict: &str, data: &[u8], page_entries: &str, more: &[Vec<u8>]) -> Vec<u8> {
+    let stream = pdf_stream;
+    let page = format!(
+        "<< /Type /Page /Parent 2 0 R /Contents 4 0 R \
+         /Resources << /Shading << /S0 5 0 R >> >> {page_entries} >>"
+    );
+    let mut objects = vec![
+        b"<< /Type /Catalog /Pages 2 0 R >>".to_vec(),
+        b"<< /Type /Pages /Kids [3 0 R] /Count 1 >>".to_vec(),
+        page.into_bytes(),
+        stream("", b"/S0 sh"),
+        stream(dict, data),
+    ];
+    objects.extend(more.iter().cloned());
+    let mut out = b"%PDF-1.7\n".to_vec();
+    let mut offsets = Vec::new();
+    for (k, body) in objects.iter().enumerate() {
+        offsets.push(out.len());
+        out.extend(format!("{} 0 obj\n", k + 1).as_bytes());
+        out.extend(body);
+        out.extend(b"\nendobj\n");
+    }
+    let xref = out.len();
+    out.extend(format!("xref\n0 {}\n0000000000 65535 f \n", objects.len() + 1).as_bytes());
+    for o in offsets {
+        out.extend(format!("{o:010} 00000 n \n").as_bytes());
+    }
+    let n = objects.len() + 1;
+    out.extend(
+        format!("trailer\n<< /Size {n} /Root 1 0 R >>\nstartxref\n{xref}\n%%EOF\n").as_bytes(),
+    );
+    out
+}
+
+/// A type 6 record of one patch over the whole 255-point page (u along x, v along y up), one
+/// byte a component: `corners`, the components of c00, c03, c33 and c30 (stream order).
+fn page_patch_record(corners: &[u8]) -> Vec<u8> {
+    let sides: [(u8, u8); 12] = [
+        (0, 0),
+        (0, 85),
+        (0, 170),
+        (0, 255),
+        (85, 255),
+        (170, 255),
+        (255, 255),
+        (255, 170),
+        (255, 85),
+        (255, 0),
+        (170, 0),
+        (85, 0),
+    ];
+    let mut data = vec![0u8];
+    data.extend(sides.iter().flat_map(|&(x, y)| [x, y]));
+    data.extend(corners);
+    data
+}
+
+/// The shading dictionary of [`page_patch_record`]'s records in `space`, its component
+/// decoded to `range`.
+fn page_patch_shading(space: &str, range: &str) -> String {
+    format!(
+        "/ShadingType 6 /ColorSpace {space} /BitsPerCoordinate 8 /BitsPerComponent 8 \
+         /BitsPerFlag 8 /Decode [0 255 0 255 {range}]"
+    )
+}
+
+/// The largest difference, in 8-bit levels, between `image` (sRGB-encoded values in 0..1) and
+/// `expected` (an sRGB colour in 0..1 of the patch's parameters `(u, v)`), over a grid of pixels away from the edges; the
+/// patch fills the page, `u` along x and `v` up.
+fn largest_level_error(image: &Image, expected: impl Fn(f64, f64) -> [f64; 3]) -> f64 {
+    let (w, h) = (image.width as usize, image.height as usize);
+    let mut worst = 0.0f64;
+    for y in (4..h - 4).step_by(7) {
+        for x in (4..w - 4).step_by(7) {
+            let (u, v) = (
+                (x as f64 + 0.5) / w as f64,
+                1.0 - (y as f64 + 0.5) / h as f64,
+            );
+            let pixel = &image.data[4 * (y * w + x)..4 * (y * w + x) + 3];
+            for (got, want) in pixel.iter().zip(expected(u, v)) {
+                worst = worst.max((f64::from(*got) - want).abs() * 255.0);
+            }
+        }
+    }
+    worst
+}
+
+/// Renders the PDF `bytes` (written to `path`) as gradmesh and as pdftoppm do: the largest
+/// error in 8-bit levels against `expected` and the ΔE00 figures against poppler.
+fn against_hand_and_poppler(
+    bytes: &[u8],
+    path: &Path,
+    expected: impl Fn(f64, f64) -> [f64; 3],
+) -> (f64, Figures) {
+    std::fs::write(path, bytes).unwrap();
+    let name = path.display().to_string();
+    let picture =
+        pdf::read_pdf(bytes, 1, &Limits::DEFAULT).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let poppler = Tool::Pdftoppm.rasterise(path);
+    let ours = render_pdf(&picture, poppler.width, poppler.height, true);
+    let alpha = render_pdf(&picture, poppler.width, poppler.height, false);
+    keep(&ours, &path.with_extension("gradmesh.png"));
+    let worst = largest_level_error(&ours, expected);
+    let f = figures(
+        &Raster::from_image(&ours),
+        &poppler,
+        &mesh_pixels(&alpha),
+        &name,
+    );
+    (worst, f)
+}
+
+/// An Indexed shading (a 256-entry ramp) and a Separation one (through a type 4 tint
+/// transform into CMYK), drawn within two 8-bit levels of the colours computed by hand, and
+/// within the issue's bar of poppler's rendering.
+#[test]
+fn indexed_and_separation_shadings_render_as_computed() {
+    let dir = scratch("special-spaces");
+    // Entry i is (i, 255 - i, 128); the index runs 0 to 255 with v.
+    let ramp: Vec<u8> = (0..=255u8).flat_map(|i| [i, 255 - i, 128]).collect();
+    let hex: String = ramp.iter().map(|b| format!("{b:02X}")).collect();
+    let space = format!("[/Indexed /DeviceRGB 255 <{hex}>]");
+    let indexed = one_shading_pdf(
+        &page_patch_shading(&space, "0 255"),
+        &page_patch_record(&[0, 255, 255, 0]),
+        SQUARE_PAGE,
+        &[],
+    );
+    let ramp_at = |_u: f64, v: f64| {
+        let i = (255.0 * v).round() / 255.0;
+        [i, 1.0 - i, 128.0 / 255.0]
+    };
+    // tint t -> CMYK (0, t, t / 2, 0) -> RGB (1, 1 - t, 1 - t / 2); t bilinear over the
+    // corners 0, 0.2, 1, 0.4.
+    let tint = pdf_stream(
+        "/FunctionType 4 /Domain [0 1] /Range [0 1 0 1 0 1 0 1]",
+        b"{ 0 exch dup 0.5 mul 0 }",
+    );
+    let separation = one_shading_pdf(
+        &page_patch_shading("[/Separation /Spot /DeviceCMYK 6 0 R]", "0 1"),
+        &page_patch_record(&[0, 51, 255, 102]),
+        SQUARE_PAGE,
+        &[tint],
+    );
+    let tinted_at = |u: f64, v: f64| {
+        let t = (1.0 - u) * v * 0.2 + u * v + u * (1.0 - v) * 0.4;
+        [1.0, 1.0 - t, 1.0 - t / 2.0]
+    };
+    let indexed = against_hand_and_poppler(&indexed, &dir.join("indexed.pdf"), ramp_at);
+    let separation = against_hand_and_poppler(&separation, &dir.join("separation.pdf"), tinted_at);
+    for (name, (worst, f)) in [("indexed", indexed), ("separation", separation)] {
+        eprintln!(
+            "{name}: largest error against the hand computation {worst:.1} levels; against pdftoppm over {} pixels: mean {:.2}, 99th {:.2}",
+            f.pixels, f.mean, f.p99
+        );
+        assert!(
+            worst <= 2.0,
+            "{name}: {worst} levels from the hand computation"
+        );
+        assert!(
+            f.mean <= 1.0 && f.p99 <= 4.0,
+            "{name}: against pdftoppm {f:?}"
+        );
+    }
+    if std::env::var_os("GRADMESH_KEEP_EXPORTS").is_none() {
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

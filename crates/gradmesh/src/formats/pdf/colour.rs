@@ -1,5 +1,6 @@
 //! Colour spaces and functions of shadings: from a shading's components to sRGB.
 
+use super::postscript::Program;
 use crate::colour::{srgb_encode, ColourSpace};
 
 /// The colour spaces a patch-mesh shading may be read in.
@@ -18,15 +19,35 @@ pub enum PdfColourSpace {
         /// The `WhitePoint`.
         white: [f64; 3],
     },
+    /// `Indexed`: one component, an index rounded to the nearest entry of the table and
+    /// clipped to it, as poppler and Ghostscript look it up.
+    Indexed {
+        /// The base space.
+        base: Box<PdfColourSpace>,
+        /// The table: one colour of the base space's components per entry, entry after entry,
+        /// the bytes already mapped to the components' ranges.
+        lookup: Vec<f64>,
+    },
+    /// `Separation` (one colourant) or `DeviceN` (several): the tints, from 0 to 1, taken
+    /// through the tint transform into the alternate space.
+    Tinted {
+        /// The number of colourants.
+        colourants: usize,
+        /// The alternate space.
+        alternate: Box<PdfColourSpace>,
+        /// The tint transform: `colourants` inputs, the alternate space's components out.
+        tint: Box<Function>,
+    },
 }
 
 impl PdfColourSpace {
     /// The number of components of a colour.
     pub fn components(&self) -> usize {
         match self {
-            PdfColourSpace::Gray => 1,
+            PdfColourSpace::Gray | PdfColourSpace::Indexed { .. } => 1,
             PdfColourSpace::Rgb | PdfColourSpace::Lab { .. } => 3,
             PdfColourSpace::Cmyk => 4,
+            PdfColourSpace::Tinted { colourants, .. } => *colourants,
         }
     }
 
@@ -44,6 +65,20 @@ impl PdfColourSpace {
             PdfColourSpace::Lab { white } => {
                 let linear = lab_to_linear_srgb([at(0), at(1), at(2)], *white);
                 linear.map(|x| srgb_encode(x.clamp(0.0, 1.0)))
+            }
+            PdfColourSpace::Indexed { base, lookup } => {
+                let m = base.components();
+                let entries = lookup.len() / m;
+                let index = at(0).round().clamp(0.0, entries.saturating_sub(1) as f64) as usize;
+                base.to_srgb(lookup.get(index * m..index * m + m).unwrap_or(&[]))
+            }
+            PdfColourSpace::Tinted {
+                colourants,
+                alternate,
+                tint,
+            } => {
+                let tints: Vec<f64> = (0..*colourants).map(|k| unit(at(k))).collect();
+                alternate.to_srgb(&tint.eval_inputs(&tints))
             }
         }
     }
@@ -111,7 +146,8 @@ fn bradford(xyz: [f64; 3], from: [f64; 3], to: [f64; 3]) -> [f64; 3] {
     mul(&B_INV, scaled)
 }
 
-/// A PDF function of one input (types 0, 2 and 3), or several of one output each.
+/// A PDF function: of one input (types 0, 2 and 3, or an array of them of one output each),
+/// or a PostScript calculator program of any number of inputs (type 4).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Function {
     /// Type 0: samples over the domain, interpolated linearly.
@@ -151,12 +187,60 @@ pub enum Function {
     },
     /// An array of functions of one output each: the outputs side by side.
     Array(Vec<Function>),
+    /// Type 4: a PostScript calculator program (PDF 32000-1, 7.10.5) of any number of inputs.
+    PostScript {
+        /// `Domain`: a range per input.
+        domain: Vec<[f64; 2]>,
+        /// `Range`: a range per output.
+        range: Vec<[f64; 2]>,
+        /// The program.
+        program: Program,
+    },
+}
+
+/// `x` clipped to the range `d` (whichever way round it is given).
+fn clip(x: f64, d: [f64; 2]) -> f64 {
+    x.clamp(d[0].min(d[1]), d[0].max(d[1]))
 }
 
 impl Function {
-    /// The outputs at `x` (clipped to the domain).
+    /// The outputs at the inputs `inputs` (each clipped to the domain). A function of one
+    /// input takes the first. A type 4 program that fails (a division by zero, say) gives each
+    /// output 0 clipped to its range; programs are tried at the corners and centre of their
+    /// domain when read, so that one failing there is an error instead.
+    pub fn eval_inputs(&self, inputs: &[f64]) -> Vec<f64> {
+        match self {
+            Function::PostScript { range, .. } => self
+                .try_eval(inputs)
+                .unwrap_or_else(|_| range.iter().map(|&r| clip(0.0, r)).collect()),
+            _ => self.eval(inputs.first().copied().unwrap_or(0.0)),
+        }
+    }
+
+    /// The outputs of a type 4 function at `inputs`, or why its program failed; other
+    /// functions as [`Function::eval_inputs`] gives them.
+    pub fn try_eval(&self, inputs: &[f64]) -> Result<Vec<f64>, String> {
+        let Function::PostScript {
+            domain,
+            range,
+            program,
+        } = self
+        else {
+            return Ok(self.eval_inputs(inputs));
+        };
+        let clipped: Vec<f64> = (domain.iter().enumerate())
+            .map(|(k, &d)| clip(inputs.get(k).copied().unwrap_or(0.0), d))
+            .collect();
+        let outputs = program.run(&clipped, range.len())?;
+        Ok(outputs
+            .iter()
+            .zip(range)
+            .map(|(&y, &r)| clip(y, r))
+            .collect())
+    }
+
+    /// The outputs at `x` (clipped to the domain), for a function of one input.
     pub fn eval(&self, x: f64) -> Vec<f64> {
-        let clip = |x: f64, d: [f64; 2]| x.clamp(d[0].min(d[1]), d[0].max(d[1]));
         let interpolate = |x: f64, from: [f64; 2], to: [f64; 2]| {
             if from[1] == from[0] {
                 to[0]
@@ -207,6 +291,7 @@ impl Function {
                 .iter()
                 .flat_map(|f| f.eval(x).into_iter().take(1))
                 .collect(),
+            Function::PostScript { .. } => self.eval_inputs(&[x]),
         }
     }
 }

@@ -6,12 +6,16 @@
 //! filters of streams, with a repair of broken cross-reference data); the content streams are
 //! interpreted and the shading streams decoded here. What is read and how is in `docs/pdf.md`.
 
+mod bits;
 mod colour;
 mod content;
 mod convert;
+mod functions;
 mod objects;
+mod postscript;
 mod scene;
 mod shading;
+mod spaces;
 
 use std::path::Path;
 
@@ -20,6 +24,7 @@ use lopdf::{Dictionary, Document as LoDocument, LoadOptions, Object, ObjectId};
 
 pub use colour::{Function, PdfColourSpace, ShadingColour};
 pub use convert::{fill_to_layer, picture_to_document};
+pub use postscript::Program as PostScriptProgram;
 pub(crate) use scene::coons_interior;
 pub use scene::{Patch, PdfPicture, ShadingFill};
 pub(crate) use shading::POINT_ORDER;

@@ -4,15 +4,13 @@
 use kurbo::{Point, Rect};
 use lopdf::Object;
 
-use super::colour::{Function, PdfColourSpace, ShadingColour};
+use super::bits::BitReader;
+use super::colour::ShadingColour;
+use super::functions::read_function;
 use super::objects::{invalid, Objects};
 use super::scene::{coons_interior, Patch};
+use super::spaces::read_colour_space;
 use crate::error::{Error, ErrorKind};
-
-/// The deepest nesting of stitching functions.
-const MAX_FUNCTION_DEPTH: usize = 8;
-/// The most samples of a sampled function.
-const MAX_SAMPLES: u64 = 1 << 20;
 
 /// A shading as read, in its own coordinates.
 pub(crate) struct ReadShading {
@@ -63,7 +61,7 @@ pub(crate) fn read_shading(
         .ok_or_else(|| invalid(what, "the shading has no ColorSpace"))?;
     let space = read_colour_space(objects, space_object, &format!("{what} /ColorSpace"))?;
     let function = match objects.get(dict, b"Function", what)? {
-        Some(f) => Some(read_function(objects, f, &format!("{what} /Function"), 0)?),
+        Some(f) => Some(read_function(objects, f, &format!("{what} /Function"), 1)?),
         None => None,
     };
     let colour = ShadingColour { space, function };
@@ -89,251 +87,6 @@ pub(crate) fn read_shading(
         bbox,
         background,
     }))
-}
-
-/// Reads a colour space of a shading.
-pub(crate) fn read_colour_space(
-    objects: Objects,
-    object: &Object,
-    what: &str,
-) -> Result<PdfColourSpace, Error> {
-    let (object, _) = objects.resolve(object, what)?;
-    let unsupported = |name: &[u8]| {
-        invalid(
-            what,
-            format!(
-                "the colour space {} is not read (DeviceGray, DeviceRGB, DeviceCMYK, CalGray, CalRGB, Lab and ICCBased are)",
-                String::from_utf8_lossy(name)
-            ),
-        )
-    };
-    match object {
-        Object::Name(n) => match n.as_slice() {
-            b"DeviceGray" | b"G" => Ok(PdfColourSpace::Gray),
-            b"DeviceRGB" | b"RGB" => Ok(PdfColourSpace::Rgb),
-            b"DeviceCMYK" | b"CMYK" => Ok(PdfColourSpace::Cmyk),
-            other => Err(unsupported(other)),
-        },
-        Object::Array(items) if !items.is_empty() => {
-            let family = objects.name(&items[0], what)?;
-            let param = |k: usize| {
-                items
-                    .get(k)
-                    .ok_or_else(|| invalid(what, "the colour space array is too short"))
-            };
-            match family {
-                b"CalGray" => Ok(PdfColourSpace::Gray),
-                b"CalRGB" => Ok(PdfColourSpace::Rgb),
-                b"Lab" => {
-                    let dict = objects.dict(param(1)?, what)?;
-                    let white = objects
-                        .get(dict, b"WhitePoint", what)?
-                        .ok_or_else(|| invalid(what, "the Lab space has no WhitePoint"))?;
-                    let white = objects.numbers(white, &format!("{what} /WhitePoint"))?;
-                    if white.len() != 3 || white.iter().any(|&w| w <= 0.0) {
-                        return Err(invalid(what, "WhitePoint must be 3 positive numbers"));
-                    }
-                    Ok(PdfColourSpace::Lab {
-                        white: [white[0], white[1], white[2]],
-                    })
-                }
-                b"ICCBased" => {
-                    let dict = objects.dict(param(1)?, what)?;
-                    if let Some(alternate) = objects.get(dict, b"Alternate", what)? {
-                        return read_colour_space(
-                            objects,
-                            alternate,
-                            &format!("{what} /Alternate"),
-                        );
-                    }
-                    let n = objects
-                        .get(dict, b"N", what)?
-                        .ok_or_else(|| invalid(what, "the ICC profile stream has no N"))?;
-                    match objects.number(n, &format!("{what} /N"))? {
-                        1.0 => Ok(PdfColourSpace::Gray),
-                        3.0 => Ok(PdfColourSpace::Rgb),
-                        4.0 => Ok(PdfColourSpace::Cmyk),
-                        other => Err(invalid(
-                            what,
-                            format!("an ICC profile of {other} components"),
-                        )),
-                    }
-                }
-                other => Err(unsupported(other)),
-            }
-        }
-        other => Err(invalid(
-            what,
-            format!("expected a colour space, found {}", other.enum_variant()),
-        )),
-    }
-}
-
-/// Reads a function of one input (types 0, 2, 3, or an array of them).
-fn read_function(
-    objects: Objects,
-    object: &Object,
-    what: &str,
-    depth: usize,
-) -> Result<Function, Error> {
-    if depth > MAX_FUNCTION_DEPTH {
-        return Err(invalid(what, "functions nest too deep"));
-    }
-    let (resolved, _) = objects.resolve(object, what)?;
-    if let Object::Array(items) = resolved {
-        if items.is_empty() {
-            return Err(invalid(what, "an empty array of functions"));
-        }
-        let functions = items
-            .iter()
-            .enumerate()
-            .map(|(k, f)| read_function(objects, f, &format!("{what} [{k}]"), depth + 1))
-            .collect::<Result<_, _>>()?;
-        return Ok(Function::Array(functions));
-    }
-    let dict = objects.dict(resolved, what)?;
-    let field = |key: &[u8]| objects.get(dict, key, what);
-    let numbers = |key: &[u8]| -> Result<Option<Vec<f64>>, Error> {
-        let label = format!("{what} /{}", String::from_utf8_lossy(key));
-        field(key)?.map(|o| objects.numbers(o, &label)).transpose()
-    };
-    let domain = numbers(b"Domain")?.ok_or_else(|| invalid(what, "the function has no Domain"))?;
-    if domain.len() != 2 {
-        return Err(invalid(
-            what,
-            "the function must have one input (a Domain of 2 numbers)",
-        ));
-    }
-    let domain = [domain[0], domain[1]];
-    let kind =
-        field(b"FunctionType")?.ok_or_else(|| invalid(what, "the function has no FunctionType"))?;
-    match objects.number(kind, what)? {
-        0.0 => read_sampled(objects, resolved, what, domain),
-        2.0 => {
-            let c0 = numbers(b"C0")?.unwrap_or_else(|| vec![0.0]);
-            let c1 = numbers(b"C1")?.unwrap_or_else(|| vec![1.0]);
-            if c0.len() != c1.len() {
-                return Err(invalid(what, "C0 and C1 differ in length"));
-            }
-            let n = field(b"N")?.ok_or_else(|| invalid(what, "the function has no N"))?;
-            let n = objects.number(n, what)?;
-            Ok(Function::Exponential { domain, c0, c1, n })
-        }
-        3.0 => {
-            let list = field(b"Functions")?
-                .ok_or_else(|| invalid(what, "the stitching function has no Functions"))?;
-            let functions = match objects.resolve(list, what)?.0 {
-                Object::Array(items) if !items.is_empty() => items
-                    .iter()
-                    .enumerate()
-                    .map(|(k, f)| {
-                        read_function(objects, f, &format!("{what} /Functions [{k}]"), depth + 1)
-                    })
-                    .collect::<Result<Vec<_>, _>>()?,
-                _ => return Err(invalid(what, "Functions must be a non-empty array")),
-            };
-            let bounds = numbers(b"Bounds")?.unwrap_or_default();
-            let encode = numbers(b"Encode")?.unwrap_or_default();
-            if bounds.len() + 1 != functions.len() || encode.len() != 2 * functions.len() {
-                return Err(invalid(
-                    what,
-                    format!(
-                        "{} functions need {} Bounds and {} Encode numbers; found {} and {}",
-                        functions.len(),
-                        functions.len() - 1,
-                        2 * functions.len(),
-                        bounds.len(),
-                        encode.len()
-                    ),
-                ));
-            }
-            let encode = encode.chunks(2).map(|p| [p[0], p[1]]).collect();
-            Ok(Function::Stitching {
-                domain,
-                functions,
-                bounds,
-                encode,
-            })
-        }
-        other => Err(invalid(
-            what,
-            format!("FunctionType {other} is not read (0, 2 and 3 are)"),
-        )),
-    }
-}
-
-/// Reads a sampled function (type 0) of one input.
-fn read_sampled(
-    objects: Objects,
-    object: &Object,
-    what: &str,
-    domain: [f64; 2],
-) -> Result<Function, Error> {
-    let stream = objects.stream(object, what)?;
-    let dict = &stream.dict;
-    let numbers = |key: &[u8]| -> Result<Option<Vec<f64>>, Error> {
-        objects
-            .get(dict, key, what)?
-            .map(|o| objects.numbers(o, what))
-            .transpose()
-    };
-    let size = numbers(b"Size")?.ok_or_else(|| invalid(what, "the function has no Size"))?;
-    let range = numbers(b"Range")?.ok_or_else(|| invalid(what, "the function has no Range"))?;
-    let bits = numbers(b"BitsPerSample")?
-        .and_then(|b| b.first().copied())
-        .ok_or_else(|| invalid(what, "the function has no BitsPerSample"))?;
-    if size.len() != 1 || !(1.0..=MAX_SAMPLES as f64).contains(&size[0]) {
-        return Err(invalid(
-            what,
-            format!("Size must be one count from 1 to {MAX_SAMPLES}"),
-        ));
-    }
-    if ![1.0, 2.0, 4.0, 8.0, 12.0, 16.0, 24.0, 32.0].contains(&bits) {
-        return Err(invalid(
-            what,
-            format!("BitsPerSample {bits} is not 1, 2, 4, 8, 12, 16, 24 or 32"),
-        ));
-    }
-    if range.len() < 2 || range.len() % 2 != 0 {
-        return Err(invalid(what, "Range must be pairs of numbers"));
-    }
-    let (size, bits, outputs) = (size[0] as usize, bits as u32, range.len() / 2);
-    let encode = numbers(b"Encode")?.unwrap_or_else(|| vec![0.0, (size - 1) as f64]);
-    let decode = numbers(b"Decode")?.unwrap_or_else(|| range.clone());
-    if encode.len() != 2 || decode.len() != range.len() {
-        return Err(invalid(what, "Encode or Decode has the wrong length"));
-    }
-    let data = objects.stream_data(stream, what, MAX_SAMPLES * 8)?;
-    let needed = (size * outputs) as u64 * u64::from(bits);
-    if (data.len() as u64) * 8 < needed {
-        return Err(invalid(
-            what,
-            format!(
-                "the stream holds {} bytes, fewer than its {size} samples need",
-                data.len()
-            ),
-        ));
-    }
-    let mut reader = BitReader::new(&data);
-    let max = ((1u64 << bits) - 1) as f64;
-    let mut samples = Vec::with_capacity(size * outputs);
-    for _ in 0..size {
-        for k in 0..outputs {
-            let raw = reader.read(bits).unwrap_or(0) as f64;
-            let value = decode[2 * k] + raw * (decode[2 * k + 1] - decode[2 * k]) / max;
-            samples.push(value.clamp(
-                range[2 * k].min(range[2 * k + 1]),
-                range[2 * k].max(range[2 * k + 1]),
-            ));
-        }
-    }
-    Ok(Function::Sampled {
-        domain,
-        encode: [encode[0], encode[1]],
-        size,
-        samples,
-        outputs,
-    })
 }
 
 /// The layout of a shading's patch records.
@@ -408,42 +161,6 @@ impl RecordLayout {
     }
 }
 
-/// Reads big-endian bit fields.
-struct BitReader<'a> {
-    data: &'a [u8],
-    bit: u64,
-}
-
-impl<'a> BitReader<'a> {
-    fn new(data: &'a [u8]) -> Self {
-        BitReader { data, bit: 0 }
-    }
-
-    fn remaining(&self) -> u64 {
-        (self.data.len() as u64 * 8).saturating_sub(self.bit)
-    }
-
-    /// The next `bits` (at most 32) as an unsigned number; `None` past the end.
-    fn read(&mut self, bits: u32) -> Option<u64> {
-        if self.remaining() < u64::from(bits) {
-            return None;
-        }
-        let mut value = 0u64;
-        for _ in 0..bits {
-            let byte = self.data[(self.bit / 8) as usize];
-            let b = (byte >> (7 - (self.bit % 8))) & 1;
-            value = (value << 1) | u64::from(b);
-            self.bit += 1;
-        }
-        Some(value)
-    }
-
-    /// Skips to the next byte boundary.
-    fn align(&mut self) {
-        self.bit = self.bit.div_ceil(8) * 8;
-    }
-}
-
 /// The stream positions of the points of a type 7 record with flag 0: `(i, j)` of `p[i][j]`,
 /// `i` along `u` (the writer's order too).
 pub(crate) const POINT_ORDER: [(usize, usize); 16] = [
@@ -492,7 +209,7 @@ fn decode_patches(
     let mut reader = BitReader::new(data);
     let mut patches: Vec<Patch> = Vec::with_capacity(most as usize);
     while reader.remaining() > 0 {
-        let start = reader.bit / 8;
+        let start = reader.byte_position();
         if data[start as usize..].iter().all(|&b| b == 0)
             && reader.remaining() < layout.record_bits(layout.points, 4)
         {

@@ -228,3 +228,187 @@ fn ai_files_are_pdf_inside() {
     assert!(!is_pdf(b"<svg/>"));
     assert!(crate::formats::is_pdf_path(std::path::Path::new("x.AI")));
 }
+
+/// A type 6 record of [`coons_record`]'s patch with one component a corner, `corners` in
+/// stream order (c00, c03, c33, c30).
+fn one_component_record(corners: [u8; 4]) -> Vec<u8> {
+    let mut data = coons_record()[..25].to_vec();
+    data.extend(corners);
+    data
+}
+
+/// A shading dictionary of one 8-bit component a corner in `space`, decoded to `range`.
+fn one_component_shading(space: &str, range: &str) -> String {
+    format!(
+        "/ShadingType 6 /ColorSpace {space} /BitsPerCoordinate 8 /BitsPerComponent 8 \
+         /BitsPerFlag 8 /Decode [0 255 0 255 {range}]"
+    )
+}
+
+/// The fill of page 1 of a page painting a shading of `dict` with `corners`, `more` from
+/// object 7.
+fn read_one(dict: &str, corners: [u8; 4], more: Vec<Vec<u8>>) -> Result<ShadingFill, String> {
+    let file = page_with("/S0 sh", stream(dict, &one_component_record(corners)), more);
+    let mut picture = read_pdf(&file, 1, &Limits::DEFAULT).map_err(|e| e.to_string())?;
+    Ok(picture.fills.remove(0))
+}
+
+fn assert_near(got: [f64; 3], expected: [f64; 3]) {
+    let close = got.iter().zip(expected).all(|(a, b)| (a - b).abs() < 1e-9);
+    assert!(close, "{got:?} against {expected:?}");
+}
+
+#[test]
+fn indexed_corners_round_to_their_entries() {
+    // Red, green, blue; corners 0, 1, 2, 1 (c00, c03, c33, c30).
+    let space = "[/Indexed /DeviceRGB 2 <FF0000 00FF00 0000FF>]";
+    let fill = read_one(&one_component_shading(space, "0 255"), [0, 1, 2, 1], vec![]).unwrap();
+    let (p, at) = (&fill.patches[0], |u, v| {
+        fill.srgb_at(&fill.patches[0], u, v)
+    });
+    assert_eq!(p.components, vec![0.0, 1.0, 1.0, 2.0]);
+    assert_near(at(0.0, 0.0), [1.0, 0.0, 0.0]);
+    assert_near(at(1.0, 1.0), [0.0, 0.0, 1.0]);
+    // The index is bilinear and rounded: 0.25 is entry 0, 0.5 and the centre's 1 entry 1.
+    assert_near(at(0.0, 0.25), [1.0, 0.0, 0.0]);
+    assert_near(at(0.0, 0.5), [0.0, 1.0, 0.0]);
+    assert_near(at(0.5, 0.5), [0.0, 1.0, 0.0]);
+    // An index past hival is the last entry.
+    let fill = read_one(&one_component_shading(space, "0 255"), [9, 9, 9, 9], vec![]).unwrap();
+    assert_near(fill.srgb_at(&fill.patches[0], 0.5, 0.5), [0.0, 0.0, 1.0]);
+}
+
+#[test]
+fn an_indexed_lookup_stream_over_lab_takes_the_base_ranges() {
+    // Two Lab entries: bytes (255, 128, 128) and (0, 0, 255) over L 0..100, a and b -128..127.
+    let lab = "[/Lab << /WhitePoint [0.95047 1 1.08883] /Range [-128 127 -128 127] >>]";
+    let space = format!("[/Indexed {lab} 1 7 0 R]");
+    let table = stream("", &[255, 128, 128, 0, 0, 255]);
+    let fill = read_one(
+        &one_component_shading(&space, "0 255"),
+        [0, 0, 1, 1],
+        vec![table],
+    );
+    let fill = fill.unwrap();
+    let PdfColourSpace::Indexed { lookup, .. } = &fill.colour.space else {
+        panic!("{:?}", fill.colour.space)
+    };
+    assert_eq!(*lookup, [100.0, 0.0, 0.0, 0.0, -128.0, 127.0]);
+    // Entry 0 is Lab white.
+    let white = fill.srgb_at(&fill.patches[0], 0.0, 0.0);
+    assert!(white.iter().all(|c| (c - 1.0).abs() < 1e-3), "{white:?}");
+}
+
+#[test]
+fn bad_indexed_spaces_are_errors_naming_the_object() {
+    let cases = [
+        ("[/Indexed /DeviceRGB 2 <FF0000 00FF00>]", "holds 6 bytes"),
+        ("[/Indexed /DeviceRGB 300 <FF>]", "hival 300"),
+        ("[/Indexed /DeviceRGB 1.5 <FF>]", "hival 1.5"),
+        ("[/Indexed /DeviceRGB 0]", "4 entries"),
+        (
+            "[/Indexed [/Indexed /DeviceRGB 0 <000000>] 0 <00>]",
+            "base of an Indexed",
+        ),
+        ("[/Indexed /DeviceRGB 0 12]", "string or a stream"),
+    ];
+    for (space, reason) in cases {
+        let e = read_one(&one_component_shading(space, "0 255"), [0; 4], vec![]).unwrap_err();
+        assert!(
+            e.contains("object 5 /ColorSpace") && e.contains(reason),
+            "{space}: {e}"
+        );
+    }
+    // A space whose base is itself: nesting is bounded.
+    let dict = one_component_shading("7 0 R", "0 255");
+    let looped = b"[/Indexed 7 0 R 0 <00>]".to_vec();
+    let e = read_one(&dict, [0; 4], vec![looped]).unwrap_err();
+    assert!(e.contains("nest deeper than"), "{e}");
+}
+
+/// A type 4 function of `inputs` inputs (`Domain` [0 1] each) and `outputs` outputs
+/// ([0 1] each) running `program`.
+fn postscript_function(inputs: usize, outputs: usize, program: &str) -> Vec<u8> {
+    let dict = format!(
+        "/FunctionType 4 /Domain [{}] /Range [{}]",
+        "0 1 ".repeat(inputs),
+        "0 1 ".repeat(outputs)
+    );
+    stream(&dict, program.as_bytes())
+}
+
+#[test]
+fn a_separation_through_a_type_4_tint_transform() {
+    // tint t -> CMYK (0, t, t / 2, 0) -> RGB (1, 1 - t, 1 - t / 2), naively.
+    let tint = postscript_function(1, 4, "{ 0 exch dup 0.5 mul 0 }");
+    let space = "[/Separation /Spot /DeviceCMYK 7 0 R]";
+    let dict = one_component_shading(space, "0 1");
+    let fill = read_one(&dict, [0, 51, 255, 102], vec![tint]).unwrap();
+    let at = |u, v| fill.srgb_at(&fill.patches[0], u, v);
+    let expected = |t: f64| [1.0, 1.0 - t, 1.0 - t / 2.0];
+    assert_near(at(0.0, 0.0), expected(0.0));
+    assert_near(at(0.0, 1.0), expected(0.2));
+    assert_near(at(1.0, 1.0), expected(1.0));
+    assert_near(at(1.0, 0.0), expected(0.4));
+    // The centre's tint is the corners' mean, 0.4.
+    assert_near(at(0.5, 0.5), expected(0.4));
+}
+
+#[test]
+fn a_device_n_space_of_two_colourants() {
+    // (a, b) -> RGB (a, b, (a + b) / 2); two components a corner.
+    let tint = postscript_function(2, 3, "{ 2 copy add 2 div }");
+    let space = "[/DeviceN [/A /B] /DeviceRGB 7 0 R]";
+    let dict = format!(
+        "/ShadingType 6 /ColorSpace {space} /BitsPerCoordinate 8 /BitsPerComponent 8 \
+         /BitsPerFlag 8 /Decode [0 255 0 255 0 1 0 1]"
+    );
+    let mut record = coons_record()[..25].to_vec();
+    record.extend([0, 0, 255, 0, 255, 255, 0, 255]);
+    let file = page_with("/S0 sh", stream(&dict, &record), vec![tint]);
+    let picture = read_pdf(&file, 1, &Limits::DEFAULT).unwrap();
+    let fill = &picture.fills[0];
+    let at = |u, v| fill.srgb_at(&fill.patches[0], u, v);
+    assert_near(at(0.0, 0.0), [0.0, 0.0, 0.0]);
+    assert_near(at(0.0, 1.0), [1.0, 0.0, 0.5]);
+    assert_near(at(1.0, 1.0), [1.0, 1.0, 1.0]);
+    assert_near(at(0.5, 0.5), [0.5, 0.5, 0.5]);
+}
+
+#[test]
+fn bad_tint_transforms_are_errors_naming_the_object() {
+    let dict = one_component_shading("[/Separation /Spot /DeviceRGB 7 0 R]", "0 1");
+    let cases = [
+        (
+            postscript_function(1, 3, "{ 1 exch div dup dup }"),
+            "fails at the inputs [0.0]",
+        ),
+        (
+            postscript_function(1, 3, "{ dup dup moveto }"),
+            "moveto is not an operator",
+        ),
+        (
+            postscript_function(2, 3, "{ pop dup dup }"),
+            "1 input (a Domain of 2 numbers)",
+        ),
+        (
+            stream("/FunctionType 4 /Domain [0 1]", b"{ dup dup }"),
+            "has no Range",
+        ),
+    ];
+    for (function, reason) in cases {
+        let e = read_one(&dict, [0; 4], vec![function]).unwrap_err();
+        assert!(
+            e.contains("object 5 /ColorSpace (the Separation tint transform)")
+                && e.contains(reason),
+            "{reason}: {e}"
+        );
+    }
+    let dict = one_component_shading("[/DeviceN [/A /B] /DeviceRGB 7 0 R]", "0 1 0 1");
+    let exponential = b"<< /FunctionType 2 /Domain [0 1 0 1] /C1 [1 1 1] /N 1 >>".to_vec();
+    let e = read_one(&dict, [0; 4], vec![exponential]).unwrap_err();
+    assert!(
+        e.contains("of 2 inputs of FunctionType 2 is not read"),
+        "{e}"
+    );
+}
