@@ -86,17 +86,13 @@ pub fn read_pdf(bytes: &[u8], page: usize, limits: &Limits) -> Result<PdfPicture
         .map_err(|e| invalid(&what, format!("it is not a dictionary: {e}")))?;
     let crop_box = page_box(objects, page_dict, &what)?;
     let mut warnings = Vec::new();
-    if let Some(rotate) = inherited(objects, page_dict, b"Rotate", &what)? {
-        let degrees = objects.number(rotate, &format!("{what} /Rotate"))?;
-        if degrees.rem_euclid(360.0) != 0.0 {
-            warnings.push(format!("{what}: /Rotate {degrees} is not applied"));
-        }
-    }
+    let rotation = page_rotation(objects, page_dict, &what, &mut warnings)?;
     let resources = inherited(objects, page_dict, b"Resources", &what)?
         .map(|r| objects.dict(r, &format!("{what} /Resources")))
         .transpose()?;
     let data = page_content(objects, page_dict, &what, limits.input_bytes)?;
-    let to_picture = Affine::new([1.0, 0.0, 0.0, -1.0, -crop_box.x0, crop_box.y1]);
+    let upright = Affine::new([1.0, 0.0, 0.0, -1.0, -crop_box.x0, crop_box.y1]);
+    let to_picture = rotation_on_picture(rotation, crop_box) * upright;
     let mut interpreter = content::Interpreter::new(
         objects,
         ShadingLimits {
@@ -110,6 +106,7 @@ pub fn read_pdf(bytes: &[u8], page: usize, limits: &Limits) -> Result<PdfPicture
         page,
         pages: pages.len(),
         crop_box,
+        rotation,
         fills: interpreter.fills,
         warnings,
     })
@@ -177,6 +174,41 @@ fn page_box(objects: Objects, page: &Dictionary, what: &str) -> Result<Rect, Err
         return Err(invalid(what, "the page's crop box is empty"));
     }
     Ok(crop)
+}
+
+/// The page's `/Rotate` (inherited), as 0, 90, 180 or 270 degrees clockwise; a value that is
+/// not a multiple of 90 is not applied (a warning says so), as poppler and MuPDF do.
+fn page_rotation(
+    objects: Objects,
+    page: &Dictionary,
+    what: &str,
+    warnings: &mut Vec<String>,
+) -> Result<u16, Error> {
+    let Some(rotate) = inherited(objects, page, b"Rotate", what)? else {
+        return Ok(0);
+    };
+    let degrees = objects.number(rotate, &format!("{what} /Rotate"))?;
+    let turned = degrees.rem_euclid(360.0);
+    if turned.rem_euclid(90.0) != 0.0 {
+        warnings.push(format!(
+            "{what}: /Rotate {degrees} is not a multiple of 90 and is not applied"
+        ));
+        return Ok(0);
+    }
+    Ok(turned as u16)
+}
+
+/// The picture of the upright page (the crop box `crop`, y down, its top-left corner at the
+/// origin) turned `rotation` degrees clockwise, as viewers show a page with `/Rotate`, with
+/// the turned picture's top-left corner at the origin.
+fn rotation_on_picture(rotation: u16, crop: Rect) -> Affine {
+    let (w, h) = (crop.width(), crop.height());
+    match rotation {
+        90 => Affine::new([0.0, 1.0, -1.0, 0.0, h, 0.0]),
+        180 => Affine::new([-1.0, 0.0, 0.0, -1.0, w, h]),
+        270 => Affine::new([0.0, -1.0, 1.0, 0.0, 0.0, w]),
+        _ => Affine::IDENTITY,
+    }
 }
 
 /// The entry `key` of the page, or of the nearest ancestor in the page tree that has it.

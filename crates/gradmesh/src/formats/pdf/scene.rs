@@ -9,9 +9,9 @@ use crate::formats::svg::FillRule;
 /// The patch-mesh shadings of one page of a PDF file, in paint order.
 ///
 /// Guarantees after [`read_pdf`](super::read_pdf):
-/// * every coordinate is in picture units: the page's crop box with its top-left corner at the
-///   origin, y down, one unit per point; the CTM, the pattern matrix and the form matrices are
-///   applied;
+/// * every coordinate is in picture units: the page's crop box turned by its `/Rotate`, with
+///   its top-left corner at the origin, y down, one unit per point; the CTM, the pattern matrix
+///   and the form matrices are applied;
 /// * every number is finite;
 /// * every fill has at least one patch.
 #[derive(Clone, Debug, PartialEq)]
@@ -22,6 +22,8 @@ pub struct PdfPicture {
     pub pages: usize,
     /// The crop box in the page's default user space (y up), as the file gives it.
     pub crop_box: Rect,
+    /// The page's `/Rotate`: 0, 90, 180 or 270 degrees clockwise, applied to the picture.
+    pub rotation: u16,
     /// The patch-mesh shadings painted on the page, bottom first.
     pub fills: Vec<ShadingFill>,
     /// What was read but is not in `fills`, or was read approximately, naming the object.
@@ -29,9 +31,14 @@ pub struct PdfPicture {
 }
 
 impl PdfPicture {
-    /// The rectangle of picture units the page shows: `(0, 0)` to the crop box's size.
+    /// The rectangle of picture units the page shows: `(0, 0)` to the crop box's size, width
+    /// and height swapped when the page is turned a quarter.
     pub fn view_rect(&self) -> Rect {
-        Rect::new(0.0, 0.0, self.crop_box.width(), self.crop_box.height())
+        let (w, h) = (self.crop_box.width(), self.crop_box.height());
+        match self.rotation {
+            90 | 270 => Rect::new(0.0, 0.0, h, w),
+            _ => Rect::new(0.0, 0.0, w, h),
+        }
     }
 }
 

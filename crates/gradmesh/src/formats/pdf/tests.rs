@@ -412,3 +412,105 @@ fn bad_tint_transforms_are_errors_naming_the_object() {
         "{e}"
     );
 }
+
+/// A page of 300 x 200 points painting the patch of [`coons_record`] with `sh`, `/Rotate`
+/// given by the page tree's root (inherited) and, when `on_page` is some, by the page.
+fn rotated_page(inherited: i32, on_page: Option<&str>) -> PdfPicture {
+    let page = format!(
+        "<< /Type /Page /Parent 2 0 R /MediaBox [0 0 300 200] /Contents 4 0 R /Resources << /Shading << /S0 5 0 R >> >> {} >>",
+        on_page.map(|r| format!("/Rotate {r}")).unwrap_or_default()
+    );
+    let objects = [
+        b"<< /Type /Catalog /Pages 2 0 R >>".to_vec(),
+        format!("<< /Type /Pages /Kids [3 0 R] /Count 1 /Rotate {inherited} >>").into_bytes(),
+        page.into_bytes(),
+        stream("", b"/S0 sh"),
+        stream(SHADING_DICT, &coons_record()),
+    ];
+    read_pdf(&pdf_file(&objects, ""), 1, &Limits::DEFAULT).unwrap()
+}
+
+/// `/Rotate` inherited, on the page, the rotation read, the view, and three corners.
+type RotationCase<'a> = (i32, Option<&'a str>, u16, Rect, [Point; 3]);
+
+#[test]
+fn rotate_turns_the_picture_clockwise() {
+    // Shading points (0, 0), (0, 255) and (255, 0): upright at (0, 200), (0, -55), (255, 200).
+    let corners = |p: &PdfPicture| {
+        let q = &p.fills[0].patches[0].points;
+        [q[0][0], q[0][3], q[3][0]]
+    };
+    let cases: [RotationCase; 5] = [
+        (
+            0,
+            None,
+            0,
+            Rect::new(0.0, 0.0, 300.0, 200.0),
+            [
+                Point::new(0.0, 200.0),
+                Point::new(0.0, -55.0),
+                Point::new(255.0, 200.0),
+            ],
+        ),
+        // A quarter clockwise: (x, y) to (200 - y, x).
+        (
+            90,
+            None,
+            90,
+            Rect::new(0.0, 0.0, 200.0, 300.0),
+            [
+                Point::new(0.0, 0.0),
+                Point::new(255.0, 0.0),
+                Point::new(0.0, 255.0),
+            ],
+        ),
+        // The page's own entry wins over the inherited one: (x, y) to (300 - x, 200 - y).
+        (
+            90,
+            Some("180"),
+            180,
+            Rect::new(0.0, 0.0, 300.0, 200.0),
+            [
+                Point::new(300.0, 0.0),
+                Point::new(300.0, 255.0),
+                Point::new(45.0, 0.0),
+            ],
+        ),
+        // -90 is 270: (x, y) to (y, 300 - x).
+        (
+            -90,
+            None,
+            270,
+            Rect::new(0.0, 0.0, 200.0, 300.0),
+            [
+                Point::new(200.0, 300.0),
+                Point::new(-55.0, 300.0),
+                Point::new(200.0, 45.0),
+            ],
+        ),
+        (
+            0,
+            Some("450"),
+            90,
+            Rect::new(0.0, 0.0, 200.0, 300.0),
+            [
+                Point::new(0.0, 0.0),
+                Point::new(255.0, 0.0),
+                Point::new(0.0, 255.0),
+            ],
+        ),
+    ];
+    for (inherited, on_page, rotation, view, points) in cases {
+        let picture = rotated_page(inherited, on_page);
+        assert_eq!(picture.rotation, rotation, "{inherited} {on_page:?}");
+        assert_eq!(picture.view_rect(), view, "{inherited} {on_page:?}");
+        assert_eq!(corners(&picture), points, "{inherited} {on_page:?}");
+        assert!(picture.warnings.is_empty(), "{:?}", picture.warnings);
+    }
+    let picture = rotated_page(0, Some("45"));
+    assert_eq!(picture.rotation, 0);
+    assert!(picture
+        .warnings
+        .iter()
+        .any(|w| w.contains("/Rotate 45 is not a multiple of 90")));
+}
