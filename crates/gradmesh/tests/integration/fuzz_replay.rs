@@ -10,11 +10,13 @@ use std::fs;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
-const TARGETS: [&str; 7] = [
+const TARGETS: [&str; 9] = [
     "parse_json",
     "parse_off",
     "parse_obj",
     "parse_svg",
+    "parse_pdf",
+    "parse_pdf_shading",
     "pipeline",
     "render",
     "vectorise",

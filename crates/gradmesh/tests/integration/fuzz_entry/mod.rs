@@ -10,6 +10,7 @@
 
 #![allow(dead_code)]
 
+pub mod pdf;
 pub mod render;
 
 use arbitrary::Arbitrary;
@@ -425,6 +426,8 @@ pub fn run_target(target: &str, data: &[u8]) {
         Some(format) => parse(format, data),
         None if target == "pipeline" => pipeline_bytes(data),
         None if target == "render" => render::render_bytes(data),
+        None if target == "parse_pdf" => pdf::parse_pdf(data),
+        None if target == "parse_pdf_shading" => pdf::parse_pdf_shading(data),
         None if target == "vectorise" => vectorise_bytes(data),
         None => panic!("unknown fuzz target {target}"),
     }
