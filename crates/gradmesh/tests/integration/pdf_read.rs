@@ -18,6 +18,7 @@ use palette::color_difference::Ciede2000;
 use palette::{white_point::D65, Lab};
 
 use super::export::{Raster, Tool};
+use super::fuzz_entry::pdf::{pdf_file, stream_object};
 use super::realdata;
 
 /// Pixels this close to the covered area's edge are not mesh pixels.
@@ -328,14 +329,6 @@ fn inkscape_pdf_converts_into_the_scheme() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// A stream object of the dictionary entries `dict` and the data `data`.
-fn pdf_stream(dict: &str, data: &[u8]) -> Vec<u8> {
-    let mut s = format!("<< {dict} /Length {} >>\nstream\n", data.len()).into_bytes();
-    s.extend(data);
-    s.extend(b"\nendstream");
-    s
-}
-
 /// The page entries of a page of 255 x 255 points.
 const SQUARE_PAGE: &str = "/MediaBox [0 0 255 255]";
 
@@ -343,7 +336,7 @@ const SQUARE_PAGE: &str = "/MediaBox [0 0 255 255]";
 /// with `sh`; `page_entries` (the boxes, say) are added to the page's dictionary and `more`
 /// objects are numbered from 6. The cross-reference table is correct.
 fn one_shading_pdf(dict: &str, data: &[u8], page_entries: &str, more: &[Vec<u8>]) -> Vec<u8> {
-    let stream = pdf_stream;
+    let stream = stream_object;
     let page = format!(
         "<< /Type /Page /Parent 2 0 R /Contents 4 0 R \
          /Resources << /Shading << /S0 5 0 R >> >> {page_entries} >>"
@@ -356,24 +349,7 @@ fn one_shading_pdf(dict: &str, data: &[u8], page_entries: &str, more: &[Vec<u8>]
         stream(dict, data),
     ];
     objects.extend(more.iter().cloned());
-    let mut out = b"%PDF-1.7\n".to_vec();
-    let mut offsets = Vec::new();
-    for (k, body) in objects.iter().enumerate() {
-        offsets.push(out.len());
-        out.extend(format!("{} 0 obj\n", k + 1).as_bytes());
-        out.extend(body);
-        out.extend(b"\nendobj\n");
-    }
-    let xref = out.len();
-    out.extend(format!("xref\n0 {}\n0000000000 65535 f \n", objects.len() + 1).as_bytes());
-    for o in offsets {
-        out.extend(format!("{o:010} 00000 n \n").as_bytes());
-    }
-    let n = objects.len() + 1;
-    out.extend(
-        format!("trailer\n<< /Size {n} /Root 1 0 R >>\nstartxref\n{xref}\n%%EOF\n").as_bytes(),
-    );
-    out
+    pdf_file(&objects)
 }
 
 /// A type 6 record of one patch over the whole 255-point page (u along x, v along y up), one
@@ -476,7 +452,7 @@ fn indexed_and_separation_shadings_render_as_computed() {
     };
     // tint t -> RGB (1, 1 - t, 1 - t / 2); t bilinear over the corners 0, 0.2, 1, 0.4. (An
     // alternate space of RGB: poppler's CMYK is not the naive conversion gradmesh documents.)
-    let tint = pdf_stream(
+    let tint = stream_object(
         "/FunctionType 4 /Domain [0 1] /Range [0 1 0 1 0 1]",
         b"{ 1 exch dup 1 exch sub exch 0.5 mul 1 exch sub }",
     );

@@ -72,6 +72,12 @@ pub fn page_with_shading(dict: &str, data: &[u8]) -> Vec<u8> {
             b"{ 0 exch dup 0.5 mul 0 }",
         ),
     ];
+    pdf_file(&objects)
+}
+
+/// A PDF file of `objects` (numbered from 1; object 1 the catalogue) with a correct
+/// cross-reference table.
+pub fn pdf_file(objects: &[Vec<u8>]) -> Vec<u8> {
     let mut out = b"%PDF-1.7\n".to_vec();
     let mut offsets = Vec::new();
     for (k, body) in objects.iter().enumerate() {
@@ -92,7 +98,8 @@ pub fn page_with_shading(dict: &str, data: &[u8]) -> Vec<u8> {
     out
 }
 
-fn stream_object(dict: &str, data: &[u8]) -> Vec<u8> {
+/// A stream object of the dictionary entries `dict` and the data `data`.
+pub fn stream_object(dict: &str, data: &[u8]) -> Vec<u8> {
     let mut s = format!("<< {dict} /Length {} >>\nstream\n", data.len()).into_bytes();
     s.extend(data);
     s.extend(b"\nendstream");
