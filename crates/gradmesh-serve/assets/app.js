@@ -27,7 +27,12 @@ const editor = {
   // Drag latency, in milliseconds of the page's clock: a drag's move waits in `moves` until
   // the batch that carries it goes out, then in `inFlight` until that batch's answer (its
   // frame drawn) comes; `samples` keeps each move's time to its frame, the newest 4,000.
-  latency: { moves: [], inFlight: [], samples: [] },
+  // Its parts: `waits`, each move's time until its batch went out; per batch of moves,
+  // `roundTrips` from sending to the answer's end, `server` the server's time on the batch
+  // within it, and `work` the time the page spent handling the answer's messages (frame,
+  // state).
+  latency: { moves: [], inFlight: [], samples: [], waits: [], roundTrips: [], server: [],
+    work: [], sentAt: 0, handling: 0 },
   overlayQueued: false, // the overlay is to be drawn at the next animation frame
 };
 window.gradmesh = editor;
@@ -42,11 +47,13 @@ function connect() {
   socket.binaryType = "arraybuffer";
   socket.onopen = () => { editor.busy = false; send({ type: "state" }); };
   socket.onmessage = (event) => {
+    const start = performance.now();
     if (typeof event.data === "string") {
       receiveText(JSON.parse(event.data));
     } else {
       drawFrame(event.data);
     }
+    editor.latency.handling += performance.now() - start;
   };
   socket.onclose = () => {
     showMessage("The connection to the server is closed: reload the page once it runs again.");
@@ -78,17 +85,28 @@ function flush() {
   }
   editor.pending = [];
   editor.busy = true;
-  editor.latency.inFlight.push(...editor.latency.moves);
-  editor.latency.moves = [];
+  const latency = editor.latency;
+  latency.sentAt = performance.now();
+  latency.handling = 0;
+  for (const moved of latency.moves) latency.waits.push(latency.sentAt - moved);
+  latency.inFlight.push(...latency.moves);
+  latency.moves = [];
 }
 
-// The batch out is answered: its frame is on the canvas.
-function noteFrameReady() {
+// The batch out is answered (the server took `serverMs` on it): its frame is on the canvas.
+function noteFrameReady(serverMs) {
   const latency = editor.latency;
   const now = performance.now();
+  if (latency.inFlight.length > 0) {
+    latency.roundTrips.push(now - latency.sentAt);
+    latency.server.push(serverMs);
+    latency.work.push(latency.handling);
+  }
   for (const moved of latency.inFlight) latency.samples.push(now - moved);
   latency.inFlight = [];
-  if (latency.samples.length > 4000) latency.samples.splice(0, latency.samples.length - 4000);
+  for (const list of [latency.samples, latency.waits, latency.roundTrips, latency.server, latency.work]) {
+    if (list.length > 4000) list.splice(0, list.length - 4000);
+  }
 }
 
 function edit(op, gesture) {
@@ -100,7 +118,7 @@ function edit(op, gesture) {
 function receiveText(message) {
   if (message.type === "done") {
     editor.busy = false;
-    noteFrameReady();
+    noteFrameReady(message.ms);
     flush();
   } else if (message.type === "error" && answerRefusal(message)) {
     // files.js asked the user.
@@ -631,6 +649,15 @@ overlay.addEventListener("pointerup", (event) => {
     finishBox(d, at);
   }
   drawOverlay();
+});
+
+// A drag the browser takes away (a touch turned into a scroll, the window losing the pointer)
+// ends where it was: the server draws the picture exactly again once the gesture ends.
+overlay.addEventListener("pointercancel", () => {
+  const d = editor.drag;
+  editor.drag = null;
+  if (d && d.moved && d.gesture !== undefined) send({ type: "end_gesture" });
+  requestOverlay();
 });
 
 // A box drag selects the points inside; a click on nothing selects the edge or face under it.

@@ -8,6 +8,10 @@
 //! then the drags of the browser test (`drag_latency_in_a_real_browser`). A drag moves as the
 //! browser test's mouse does: out by 12 pixels and back, 2 pixels a step.
 //!
+//! A drag is drawn as the session draws it while a gesture is open, as a draft
+//! (`RenderOptions::draft`); the stages also show the exact render of the same step and the
+//! exact frame at the drag's end.
+//!
 //! `cargo bench -p gradmesh-serve --bench edit_latency`. Besides criterion's figures it prints,
 //! per artwork and edit, the median, 95th percentile and worst of 100 steps, and for the drag
 //! the time of each stage of one step. `GRADMESH_LATENCY_STEPS=N` sets the steps,
@@ -260,8 +264,17 @@ fn profile_drag(name: &str, doc: &Document, t: Target) {
     let mut pixels = vec![0u8; 4 * opts.width as usize * opts.height as usize];
     render::render_document_into_cached(doc, &opts, &mut cache, &mut pixels).expect("renders");
     let mut session = session(doc);
+    // The session draws a drag as a draft, and exactly at its end.
+    let draft = RenderOptions {
+        draft: true,
+        ..opts.clone()
+    };
+    // The same steps rendered exactly through a cache of their own, for comparison.
+    let mut exact_cache = RenderCache::new();
+    render::render_document_into_cached(doc, &opts, &mut exact_cache, &mut pixels)
+        .expect("renders");
     let n = steps();
-    let mut stages: Vec<[Duration; 6]> = Vec::with_capacity(n);
+    let mut stages: Vec<[Duration; 7]> = Vec::with_capacity(n);
     for step in 1..=n {
         let text = drag_command(t, step);
         let command: gradmesh_serve::Command = serde_json::from_str(&text).expect("a command");
@@ -275,9 +288,13 @@ fn profile_drag(name: &str, doc: &Document, t: Target) {
         let visible = history.current().visible();
         let copied = start.elapsed();
         let start = Instant::now();
-        let info = render::render_document_into_cached(&visible, &opts, &mut cache, &mut pixels)
+        let info = render::render_document_into_cached(&visible, &draft, &mut cache, &mut pixels)
             .expect("renders");
         let rendered = start.elapsed();
+        let start = Instant::now();
+        render::render_document_into_cached(&visible, &opts, &mut exact_cache, &mut pixels)
+            .expect("renders");
+        let exact = start.elapsed();
         let start = Instant::now();
         session.handle_texts(&[text]);
         let whole = start.elapsed();
@@ -288,8 +305,12 @@ fn profile_drag(name: &str, doc: &Document, t: Target) {
             info.timings.prepare,
             info.timings.draw,
             whole,
+            exact,
         ]);
     }
+    let start = Instant::now();
+    session.handle_texts(&[r#"{"type":"end_gesture"}"#.to_string()]);
+    let release = start.elapsed().as_secs_f64() * 1e3;
     let median = |k: usize| {
         let mut v: Vec<Duration> = stages.iter().map(|s| s[k]).collect();
         v.sort();
@@ -297,12 +318,14 @@ fn profile_drag(name: &str, doc: &Document, t: Target) {
     };
     println!(
         "{name} drag stages (medians): apply and validate {:.2} ms, copy of the visible layers {:.2} ms, \
-         render {:.2} ms (prepare {:.2}, draw {:.2}); whole step {:.2} ms",
+         draft render {:.2} ms (prepare {:.2}, draw {:.2}; exact render {:.2} ms); whole step {:.2} ms; \
+         the exact frame at the drag's end {release:.2} ms",
         median(0),
         median(1),
         median(2),
         median(3),
         median(4),
+        median(6),
         median(5)
     );
 }

@@ -346,9 +346,10 @@ async fn run_socket(socket: WebSocket, app: Arc<App>) {
         let mut running = session
             .take()
             .expect("the session is back after each batch");
-        let Ok((back, messages)) = tokio::task::spawn_blocking(move || {
+        let Ok((back, messages, took)) = tokio::task::spawn_blocking(move || {
+            let start = std::time::Instant::now();
             let messages = running.handle_texts(&batch);
-            (running, messages)
+            (running, messages, start.elapsed())
         })
         .await
         else {
@@ -362,7 +363,11 @@ async fn run_socket(socket: WebSocket, app: Arc<App>) {
                 | Outgoing::Notice(text)
                 | Outgoing::Select(text) => Message::Text(text.into()),
                 Outgoing::Binary(bytes) => Message::Binary(bytes.into()),
-                Outgoing::Done => Message::Text(r#"{"type":"done"}"#.into()),
+                // With the time the batch took here, for the page's latency figures.
+                Outgoing::Done => {
+                    let ms = took.as_secs_f64() * 1e3;
+                    Message::Text(format!(r#"{{"type":"done","ms":{ms:.3}}}"#).into())
+                }
             };
             if sink.send(message).await.is_err() {
                 reader.abort();

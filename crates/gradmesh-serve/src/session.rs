@@ -224,8 +224,14 @@ impl Session {
         if let Err(e) = self.keep_recovery() {
             out.push(error_message(&format!("the recovery copy: {e}")));
         }
-        let doc = self.app.editor().history.current().visible();
-        match self.viewer.render(&doc) {
+        let (doc, draft) = {
+            let editor = self.app.editor();
+            (
+                editor.history.current().visible(),
+                editor.history.gesture_open(),
+            )
+        };
+        match self.viewer.render(&doc, draft) {
             Ok(Some(frame)) => out.push(Outgoing::Binary(frame)),
             Ok(None) => {}
             Err(e) => out.push(error_message(&format!("cannot render: {e}"))),
@@ -373,6 +379,7 @@ mod tests {
     use super::*;
     use crate::editor::History;
     use crate::ops::Picture;
+    use gradmesh::render::RenderOptions;
 
     fn square_session() -> Session {
         let mut picture = Picture::default();
@@ -434,6 +441,79 @@ mod tests {
             0.0
         );
         assert!(!editor.history.can_undo_redo().0);
+    }
+
+    /// A session of a 4 x 4 grid of 100 units whose 25 points have colours of all hues.
+    fn colourful_grid_session() -> Session {
+        let mut picture = Picture::default();
+        Op::AddLayer { name: None }.apply(&mut picture).unwrap();
+        Op::AddGrid {
+            layer: 0,
+            rect: [0.0, 0.0, 100.0, 100.0],
+            columns: 4,
+            rows: 4,
+        }
+        .apply(&mut picture)
+        .unwrap();
+        Op::SetColours {
+            layer: 0,
+            points: (0..25).collect(),
+            css: (0..25)
+                .map(|i| format!("hsl({}, 90%, {}%)", i * 137 % 360, 30 + i * 7 % 50))
+                .collect(),
+        }
+        .apply(&mut picture)
+        .unwrap();
+        let editor = Editor {
+            history: History::new(picture),
+            path: None,
+        };
+        let app = App::new(editor, Folder::new(&std::env::temp_dir()).unwrap());
+        Session::new(Arc::new(app))
+    }
+
+    /// The session's document rendered from scratch as its viewer renders it, exactly.
+    fn exact_render(session: &Session) -> Vec<u8> {
+        let vp = session.viewer.viewport().unwrap();
+        let doc = session.app.editor().history.current().visible();
+        let opts = RenderOptions::new(vp.width, vp.height, vp.view);
+        let mut pixels = vec![0u8; 4 * (vp.width * vp.height) as usize];
+        gradmesh::render::render_document_into(&doc, &opts, &mut pixels).unwrap();
+        pixels
+    }
+
+    #[test]
+    fn a_drag_is_drawn_as_a_draft_and_exactly_once_it_ends() {
+        let mut session = colourful_grid_session();
+        let view = r#"{"type":"view","width":256,"height":256,"view":[-10,-10,110,110]}"#;
+        session.handle_texts(&[view.to_string()]);
+        assert_eq!(session.viewer.shown().unwrap().2, exact_render(&session));
+        for dx in 1..=5 {
+            let step = format!(
+                r#"{{"type":"edit","gesture":7,"op":{{"op":"move_points","layer":0,"points":[12],"dx":{dx},"dy":{}}}}}"#,
+                -dx
+            );
+            session.handle_texts(&[step]);
+        }
+        let (drafted, exact) = (
+            session.viewer.shown().unwrap().2.to_vec(),
+            exact_render(&session),
+        );
+        assert!(drafted != exact, "the drag was drawn exactly");
+        // Looser tolerances, a few 8-bit levels at most (dithered either side), and rarely.
+        let differences: Vec<u8> = drafted
+            .iter()
+            .zip(&exact)
+            .map(|(a, b)| a.abs_diff(*b))
+            .collect();
+        let worst = differences.iter().max().copied().unwrap_or(0);
+        let mean = differences.iter().map(|&d| d as f64).sum::<f64>() / differences.len() as f64;
+        assert!(
+            worst <= 6 && mean < 0.5,
+            "a draft {worst} levels from the exact picture, {mean} on average"
+        );
+        session.handle_texts(&[r#"{"type":"end_gesture"}"#.to_string()]);
+        assert_eq!(session.viewer.shown().unwrap().2, exact_render(&session));
     }
 
     #[test]

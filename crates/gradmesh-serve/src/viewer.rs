@@ -86,12 +86,17 @@ impl Viewer {
 
     /// Renders `doc` and encodes the rows that differ from the frame the page has, as a frame
     /// message (see [`decode_frame`] for its layout); `None` if nothing changed or no viewport
-    /// is set.
-    pub fn render(&mut self, doc: &Document) -> Result<Option<Vec<u8>>, String> {
+    /// is set. A `draft` (while a gesture is open) plans the faces the edits reach with looser
+    /// tolerances ([`RenderOptions::draft`]); the next render that is not a draft draws them
+    /// exactly again.
+    pub fn render(&mut self, doc: &Document, draft: bool) -> Result<Option<Vec<u8>>, String> {
         let Some(vp) = self.viewport else {
             return Ok(None);
         };
-        let opts = RenderOptions::new(vp.width, vp.height, vp.view);
+        let opts = RenderOptions {
+            draft,
+            ..RenderOptions::new(vp.width, vp.height, vp.view)
+        };
         let len = 4 * vp.width as usize * vp.height as usize;
         self.drawn.resize(len, 0);
         render::render_document_into_cached(doc, &opts, &mut self.cache, &mut self.drawn)

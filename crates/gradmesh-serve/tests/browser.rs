@@ -550,15 +550,23 @@ async fn measure_drag(
     );
     let latency = js(
         client,
-        "const l = window.gradmesh.latency; return [l.samples, l.moves.length, l.inFlight.length];",
+        "const l = window.gradmesh.latency; \
+         return [l.samples, l.moves.length, l.inFlight.length, l.waits, l.roundTrips, l.server, \
+         l.work];",
     )
     .await;
-    let mut samples: Vec<f64> = latency[0]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
+    let numbers = |v: &serde_json::Value| -> Vec<f64> {
+        let mut list: Vec<f64> = v
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        list.sort_by(f64::total_cmp);
+        list
+    };
+    let samples = numbers(&latency[0]);
+    let parts = [3, 4, 5, 6].map(|k| median(&numbers(&latency[k])));
     assert_eq!(latency[1], json!(0), "moves not sent");
     assert_eq!(latency[2], json!(0), "moves not answered");
     assert!(
@@ -567,19 +575,29 @@ async fn measure_drag(
         samples.len()
     );
     assert!(samples.iter().all(|t| t.is_finite() && *t >= 0.0));
-    samples.sort_by(f64::total_cmp);
     let rank = |q: f64| samples[((samples.len() - 1) as f64 * q).round() as usize];
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
     println!(
         "browser drag latency, {name} ({layer}, {point}) at 1024 px: {} moves, median {:.1} ms, \
-         95th {:.1} ms, worst {:.1} ms (load {})",
+         95th {:.1} ms, worst {:.1} ms; medians of its parts: wait to be sent {:.1} ms, \
+         round trip {:.1} ms, of which the server {:.1} ms and the page's handling {:.1} ms \
+         (load {})",
         samples.len(),
         rank(0.5),
         rank(0.95),
         samples[samples.len() - 1],
+        parts[0],
+        parts[1],
+        parts[2],
+        parts[3],
         load.split_whitespace().next().unwrap_or("?")
     );
     Ok(())
+}
+
+/// The median of sorted `values` (not a number when there are none).
+fn median(values: &[f64]) -> f64 {
+    values.get(values.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 /// Point `point` of layer `layer` in the server's document.

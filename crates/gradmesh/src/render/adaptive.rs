@@ -131,6 +131,8 @@ pub(crate) struct TessellationCache {
     /// The data of the base level the plans were made from.
     data: Vec<VertexData>,
     faces: Vec<CachedPlan>,
+    /// Whether each face's plan was made by a draft ([`RenderOptions::draft`](super::RenderOptions::draft)).
+    drafted: Vec<bool>,
     /// What the plans drew (empty until the triangles of the plans above are built).
     triangles: Option<TriangleBlocks>,
     /// The layer's refinement at its last preparation (the topology of its levels and the
@@ -156,8 +158,14 @@ impl TessellationCache {
             && self.data.len() == data.len()
     }
 
+    /// Whether some face's plan was made by a draft: a render that is not one must plan the
+    /// layer again.
+    pub(crate) fn has_drafts(&self) -> bool {
+        self.drafted.contains(&true)
+    }
+
     /// Keeps the plans `faces` made on `base_level` of the refinement `topology_id`, whose
-    /// data is `data`, in `space`.
+    /// data is `data`, in `space`; those planned now (not reused) by a draft if `draft`.
     fn keep_plans(
         &mut self,
         faces: &FacePlans,
@@ -165,7 +173,12 @@ impl TessellationCache {
         base_level: usize,
         space: ColourSpace,
         data: &[VertexData],
+        draft: bool,
     ) {
+        let drafted: Vec<bool> = (faces.reused.iter().enumerate())
+            .map(|(f, &reused)| if reused { self.drafted[f] } else { draft })
+            .collect();
+        self.drafted = drafted;
         self.faces.clear();
         self.faces.extend(faces.to_cached());
         self.data.clear();
@@ -275,7 +288,13 @@ pub(super) fn tessellate(
     let fitting_cache = cache
         .as_deref()
         .filter(|c| c.fits(topology_id, k0, th.space, nf, d));
-    let again = fitting_cache.map(|c| faces_to_plan_again(t, &c.data, d));
+    let again = fitting_cache.map(|c| {
+        let mut again = faces_to_plan_again(t, &c.data, d);
+        if !th.draft {
+            again.iter_mut().zip(&c.drafted).for_each(|(a, &d)| *a |= d);
+        }
+        again
+    });
     let earlier = fitting_cache
         .zip(again.as_deref())
         .map(|(c, again)| EarlierPlans {
@@ -288,7 +307,7 @@ pub(super) fn tessellate(
     let mut last_triangles = None;
     if let Some(cache) = cache.as_deref_mut() {
         last_triangles = cache.triangles.take().filter(|_| again.is_some());
-        cache.keep_plans(&faces, topology_id, k0, th.space, d);
+        cache.keep_plans(&faces, topology_id, k0, th.space, d, th.draft);
     }
 
     // 2. Counts per edge, and the samples faces share.

@@ -85,6 +85,15 @@ impl RenderCache {
             gamut: GamutMapping::default(),
             blend: BlendSpace::default(),
             max_pixels: 0,
+            draft: false,
+            ..opts.clone()
+        }
+    }
+
+    /// `opts` as the last image drawn is compared with: a draft draws with the same options.
+    pub(super) fn drawing_key(opts: &RenderOptions) -> RenderOptions {
+        RenderOptions {
+            draft: false,
             ..opts.clone()
         }
     }

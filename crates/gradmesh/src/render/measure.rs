@@ -9,6 +9,7 @@ use crate::colour::{ColourSpace, Matrix3};
 use crate::topology::Topology;
 use crate::validate::VertexData;
 
+use super::options::DRAFT_LOOSENING;
 use super::{each3, each4, RenderOptions};
 use crate::view::ToPixels;
 
@@ -43,18 +44,22 @@ pub(super) struct Thresholds {
     pub space: ColourSpace,
     /// Whether faces may take quadratic colour ([`RenderOptions::quadratic`]).
     pub quadratic: bool,
+    /// Whether these are a draft's looser thresholds ([`RenderOptions::draft`]).
+    pub draft: bool,
 }
 
 impl Thresholds {
     pub(super) fn new(opts: &RenderOptions, space: ColourSpace) -> Thresholds {
+        let loosening = if opts.draft { DRAFT_LOOSENING } else { 1.0 };
         Thresholds {
-            quad: opts.max_quad_px,
-            colour: ADAPTIVE_COLOUR_MARGIN * opts.colour_tolerance,
-            outline: opts.tolerance_px,
+            quad: opts.max_quad_px * loosening.sqrt(),
+            colour: ADAPTIVE_COLOUR_MARGIN * opts.colour_tolerance * loosening,
+            outline: opts.tolerance_px * loosening,
             min_quad: MIN_QUAD_PX,
             size: (opts.width as f64, opts.height as f64),
             space,
             quadratic: opts.quadratic,
+            draft: opts.draft,
         }
     }
 }

@@ -133,7 +133,7 @@ pub use crate::view::{
 };
 pub use cache::RenderCache;
 pub use info::{LayerInfo, LayerTimings, RenderInfo, RenderTimings};
-pub use options::RenderOptions;
+pub use options::{RenderOptions, DRAFT_LOOSENING};
 pub use output::{
     encode_png, encode_png_rgba16, encode_png_rgba8, write_png, write_png_rgba16, write_png_rgba8,
     write_png_rgba8_with, Image, OutputPixel, PngCompression, PngDepth,
@@ -484,7 +484,7 @@ fn ready_cache(cache: &mut RenderCache, doc: &Document, opts: &RenderOptions) {
     }
     // A document with other layers, or other drawing options, draws every band again.
     if cache.layers.len() != doc.layers.len()
-        || cache.drawn.as_ref().is_some_and(|d| d.opts != *opts)
+        || (cache.drawn.as_ref()).is_some_and(|d| d.opts != RenderCache::drawing_key(opts))
     {
         cache.drawn = None;
     }
@@ -522,13 +522,14 @@ fn prepare_layers(
         .enumerate()
         .map(|(i, (mesh, memo))| {
             let entry = cached.and_then(|c| c[i].as_ref());
-            if entry.is_some_and(|(old, _)| old == mesh) {
+            // A layer drafted by an earlier render is planned again unless this is a draft.
+            let drafted = !opts.draft && memo.as_deref().is_some_and(|m| m.has_drafts());
+            if entry.is_some_and(|(old, _)| old == mesh) && !drafted {
                 return Ok(None);
             }
-            // Plans are kept for layers prepared again (edited): keeping every layer's would
-            // cost a copy of its plans at its first preparation, and memory, for nothing.
-            let memo = memo.as_deref_mut().filter(|_| entry.is_some());
-            layer::prepare(mesh, i, opts, xf, &shapes, memo).map(Some)
+            // Plans are kept from a layer's first preparation on (shared, not copied), so
+            // that its first edit plans again only the faces the edit reaches.
+            layer::prepare(mesh, i, opts, xf, &shapes, memo.as_deref_mut()).map(Some)
         })
         .collect::<Vec<_>>()
         // The first failing layer's error, whatever the thread count.
@@ -584,7 +585,7 @@ fn draw_through_cache<'c, P: OutputPixel>(
     if !same_kind {
         dirty.fill(Columns::all(w));
         last = Some(LastImage {
-            opts: opts.clone(),
+            opts: RenderCache::drawing_key(opts),
             pixels: Box::new(out.to_vec()),
             reach: vec![f64::NEG_INFINITY; bands * nl],
         });

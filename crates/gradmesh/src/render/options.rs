@@ -58,7 +58,20 @@ pub struct RenderOptions {
     /// that passes the colour tolerance with fewer cells than linear colour (default `true`).
     /// `false` draws every face with linear colour (more triangles), for comparison.
     pub quadratic: bool,
+    /// Plan the faces this render plans with looser tolerances ([`DRAFT_LOOSENING`] times the
+    /// colour and outline tolerances, twice the largest quad), for an editor while a gesture is
+    /// open. Through a [`RenderCache`](super::RenderCache) only the faces an edit reaches are
+    /// planned, so the rest of the picture keeps its exact plans, and the next render without
+    /// `draft` plans the drafted faces again at the full tolerances: the picture after the
+    /// gesture is the one a render from scratch gives. Without a cache every face is drafted.
+    /// Only the fast path drafts (the uniform path and [`reference`](Self::reference) ignore it).
+    pub draft: bool,
 }
+
+/// How many times looser than the options' colour and outline tolerances a
+/// [`draft`](RenderOptions::draft) plans faces (a colour error under one Delta E for the
+/// default tolerance).
+pub const DRAFT_LOOSENING: f64 = 4.0;
 
 impl Default for RenderOptions {
     fn default() -> Self {
@@ -80,6 +93,7 @@ impl Default for RenderOptions {
             dither: true,
             max_pixels: MAX_PIXELS,
             quadratic: true,
+            draft: false,
         }
     }
 }

@@ -77,13 +77,14 @@ fn cached_renders_equal_fresh_ones_and_prepare_only_what_changed() {
         (vec![true; 6], vec![0; 6])
     );
 
-    // An edit of one layer: only that one is prepared again. From then on the cache keeps
-    // its faces' plans, and a second edit plans again only the faces near the point.
+    // An edit of one layer: only that one is prepared again, and only the faces near the
+    // point are planned again (the cache keeps every face's plan from the first render on).
     let p = &mut doc.layers[3].points[5];
     p.colour = [p.colour[0] * 0.8, p.colour[1] + 10.0, p.colour[2]];
     let (reused, faces) = render_both_counting(&doc, &opts, &mut cache);
     assert_eq!(reused, [true, true, true, false, true, true]);
-    assert_eq!(faces, [0; 6]);
+    assert!(faces[3] > 0, "no face kept its plan: {faces:?}");
+    assert_eq!(faces.iter().filter(|&&f| f > 0).count(), 1);
     let p = &mut doc.layers[3].points[5];
     p.colour[2] -= 5.0;
     let (reused, faces) = render_both_counting(&doc, &opts, &mut cache);
@@ -314,4 +315,65 @@ fn an_outline_change_draws_again_only_around_it() {
             );
         }
     }
+}
+
+#[test]
+fn a_draft_plans_loosely_only_what_an_edit_reaches_and_the_next_render_is_exact() {
+    let mut doc = tucan();
+    let exact = options(&doc, 600);
+    let draft = RenderOptions {
+        draft: true,
+        ..exact.clone()
+    };
+    let mut cache = RenderCache::new();
+    render_both(&doc, &exact, &mut cache);
+    let n = 4 * (exact.width * exact.height) as usize;
+    let mut pixels = vec![0u8; n];
+
+    // Nothing changed: a draft plans nothing, and draws what the exact render drew.
+    let info = render_document_into_cached(&doc, &draft, &mut cache, &mut pixels).unwrap();
+    assert!(info.layers.iter().all(|l| l.reused));
+    let mut fresh = vec![0u8; n];
+    render_document_into(&doc, &exact, &mut fresh).unwrap();
+    assert!(pixels == fresh, "a draft of an unchanged document differs");
+
+    // A point moved: the draft plans the faces near it with fewer triangles than the exact
+    // plans, keeps the others' exact plans, and leaves the other layers alone.
+    let p = &mut doc.layers[2].points[7];
+    p.position.x += 3.0;
+    p.position.y -= 2.0;
+    let drafted = render_document_into_cached(&doc, &draft, &mut cache, &mut pixels).unwrap();
+    let plain = render_document_into(&doc, &exact, &mut fresh).unwrap();
+    let reused: Vec<bool> = drafted.layers.iter().map(|l| l.reused).collect();
+    assert_eq!(reused, [true, true, false, true, true, true]);
+    assert!(
+        drafted.layers[2].reused_faces > 0,
+        "no face kept its exact plan"
+    );
+    assert!(
+        drafted.layers[2].triangles < plain.layers[2].triangles,
+        "draft {} triangles, exact {}",
+        drafted.layers[2].triangles,
+        plain.layers[2].triangles
+    );
+    let differences = pixels.iter().zip(&fresh).filter(|(a, b)| a != b).count();
+    let worst = pixels
+        .iter()
+        .zip(&fresh)
+        .map(|(a, b)| a.abs_diff(*b))
+        .max()
+        .unwrap();
+    assert!(differences > 0, "the draft drew the exact picture");
+    assert!(
+        worst <= 3,
+        "a draft's channel {worst} levels from the exact render"
+    );
+
+    // The next render without `draft` plans the drafted faces again: the exact picture, with
+    // only the drafted layer prepared again; after it nothing is left to plan.
+    assert_eq!(
+        render_both(&doc, &exact, &mut cache),
+        [true, true, false, true, true, true]
+    );
+    assert_eq!(render_both(&doc, &exact, &mut cache), [true; 6]);
 }
