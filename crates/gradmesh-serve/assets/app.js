@@ -34,6 +34,7 @@ const editor = {
   latency: { moves: [], inFlight: [], samples: [], waits: [], roundTrips: [], server: [],
     work: [], sentAt: 0, handling: 0 },
   overlayQueued: false, // the overlay is to be drawn at the next animation frame
+  foldsToCome: false,   // the last state left out the folds, which come in the next
 };
 window.gradmesh = editor;
 
@@ -130,6 +131,8 @@ function receiveText(message) {
     const first = editor.state === null;
     const folds = editor.state ? editor.state.layers.map((l) => l.folds) : [];
     editor.state = message;
+    // The server sends the folds in a state of their own once the frame is out.
+    editor.foldsToCome = !!message.folds_to_come;
     if (!message.folds_checked) {
       message.layers.forEach((layer, i) => { layer.folds = folds[i] || []; });
     }

@@ -176,7 +176,8 @@ fn session(doc: &Document) -> Session {
         path: None,
     };
     let app = Arc::new(App::new(editor, folder));
-    let mut session = Session::new(app);
+    // As the WebSocket runs it: the folds after a gesture come after its frame.
+    let mut session = Session::deferring_folds(app);
     let v = opts.view;
     let view = format!(
         r#"{{"type":"view","width":{},"height":{},"view":[{},{},{},{}]}}"#,
@@ -184,6 +185,7 @@ fn session(doc: &Document) -> Session {
     );
     let first = session.handle_texts(&[view]);
     assert!(first.iter().any(|m| matches!(m, Outgoing::Binary(_))));
+    session.owed_folds();
     session
 }
 
@@ -311,6 +313,9 @@ fn profile_drag(name: &str, doc: &Document, t: Target) {
     let start = Instant::now();
     session.handle_texts(&[r#"{"type":"end_gesture"}"#.to_string()]);
     let release = start.elapsed().as_secs_f64() * 1e3;
+    let start = Instant::now();
+    session.owed_folds();
+    let folds = start.elapsed().as_secs_f64() * 1e3;
     let median = |k: usize| {
         let mut v: Vec<Duration> = stages.iter().map(|s| s[k]).collect();
         v.sort();
@@ -319,7 +324,7 @@ fn profile_drag(name: &str, doc: &Document, t: Target) {
     println!(
         "{name} drag stages (medians): apply and validate {:.2} ms, copy of the visible layers {:.2} ms, \
          draft render {:.2} ms (prepare {:.2}, draw {:.2}; exact render {:.2} ms); whole step {:.2} ms; \
-         the exact frame at the drag's end {release:.2} ms",
+         the exact frame at the drag's end {release:.2} ms, then its folds {folds:.2} ms",
         median(0),
         median(1),
         median(2),

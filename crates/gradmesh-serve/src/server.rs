@@ -2,6 +2,7 @@
 
 use std::net::{Ipv4Addr, SocketAddr};
 use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 use axum::body::Bytes;
 use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
@@ -10,6 +11,7 @@ use axum::http::{header, StatusCode};
 use axum::response::{Html, IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::Router;
+use futures_util::stream::SplitSink;
 use futures_util::{SinkExt, StreamExt};
 use gradmesh::render::{self, RenderOptions};
 use tokio::net::TcpListener;
@@ -337,43 +339,72 @@ async fn run_socket(socket: WebSocket, app: Arc<App>) {
             }
         }
     });
-    let mut session = Some(Session::new(app));
+    let mut session = Session::deferring_folds(app);
     while let Some(first) = queued.recv().await {
         let mut batch = vec![first];
         while let Ok(next) = queued.try_recv() {
             batch.push(next);
         }
-        let mut running = session
-            .take()
-            .expect("the session is back after each batch");
-        let Ok((back, messages, took)) = tokio::task::spawn_blocking(move || {
-            let start = std::time::Instant::now();
-            let messages = running.handle_texts(&batch);
-            (running, messages, start.elapsed())
-        })
-        .await
+        let Some((back, messages, took)) =
+            on_session(session, move |s| s.handle_texts(&batch)).await
         else {
             break;
         };
-        session = Some(back);
-        for message in messages {
-            let message = match message {
-                Outgoing::Text(text)
-                | Outgoing::Error(text)
-                | Outgoing::Notice(text)
-                | Outgoing::Select(text) => Message::Text(text.into()),
-                Outgoing::Binary(bytes) => Message::Binary(bytes.into()),
-                // With the time the batch took here, for the page's latency figures.
-                Outgoing::Done => {
-                    let ms = took.as_secs_f64() * 1e3;
-                    Message::Text(format!(r#"{{"type":"done","ms":{ms:.3}}}"#).into())
-                }
+        session = back;
+        if send_all(&mut sink, messages, took).await.is_err() {
+            break;
+        }
+        // The page has its frame: now the folds its state left out, unless commands wait.
+        if session.owes_folds() && queued.is_empty() {
+            let Some((back, messages, took)) =
+                on_session(session, |s| s.owed_folds().into_iter().collect()).await
+            else {
+                break;
             };
-            if sink.send(message).await.is_err() {
-                reader.abort();
-                return;
+            session = back;
+            if send_all(&mut sink, messages, took).await.is_err() {
+                break;
             }
         }
     }
     reader.abort();
+}
+
+/// Runs `work` on the session on a blocking thread; gives the session back with the messages
+/// and the time taken (`None` if the work panicked).
+async fn on_session<F>(mut session: Session, work: F) -> Option<(Session, Vec<Outgoing>, Duration)>
+where
+    F: FnOnce(&mut Session) -> Vec<Outgoing> + Send + 'static,
+{
+    tokio::task::spawn_blocking(move || {
+        let start = Instant::now();
+        let messages = work(&mut session);
+        (session, messages, start.elapsed())
+    })
+    .await
+    .ok()
+}
+
+/// Sends `messages` to the page; "done" carries the time the batch took on the server (`took`),
+/// for the page's latency figures.
+async fn send_all(
+    sink: &mut SplitSink<WebSocket, Message>,
+    messages: Vec<Outgoing>,
+    took: Duration,
+) -> Result<(), axum::Error> {
+    for message in messages {
+        let message = match message {
+            Outgoing::Text(text)
+            | Outgoing::Error(text)
+            | Outgoing::Notice(text)
+            | Outgoing::Select(text) => Message::Text(text.into()),
+            Outgoing::Binary(bytes) => Message::Binary(bytes.into()),
+            Outgoing::Done => {
+                let ms = took.as_secs_f64() * 1e3;
+                Message::Text(format!(r#"{{"type":"done","ms":{ms:.3}}}"#).into())
+            }
+        };
+        sink.send(message).await?;
+    }
+    Ok(())
 }

@@ -167,6 +167,11 @@ pub struct Session {
     /// the generation of the file state.
     told_version: Option<(u64, bool, u64)>,
     folds: FoldCache,
+    /// Whether states leave the folds out, for [`Session::owed_folds`] to send once the page
+    /// has its frame.
+    defer_folds: bool,
+    /// Whether the last state left out folds that are to come.
+    folds_owed: bool,
     /// What the last edit's mesh tool left selected, not yet sent.
     selected: Option<Selection>,
 }
@@ -179,8 +184,38 @@ impl Session {
             viewer: Viewer::new(),
             told_version: None,
             folds: FoldCache::default(),
+            defer_folds: false,
+            folds_owed: false,
             selected: None,
         }
+    }
+
+    /// A session whose answers leave out the search for folds (it refines every changed layer
+    /// to level 4, longer than the frame takes after a drag): the state says
+    /// `"folds_to_come": true`, and [`Session::owed_folds`] gives the state with them.
+    pub fn deferring_folds(app: Arc<App>) -> Session {
+        Session {
+            defer_folds: true,
+            ..Session::new(app)
+        }
+    }
+
+    /// Whether a state left out folds that [`Session::owed_folds`] would find.
+    pub fn owes_folds(&self) -> bool {
+        self.folds_owed
+    }
+
+    /// The state with the folds the last state left out, if any (none while a gesture is open:
+    /// its end owes them again).
+    pub fn owed_folds(&mut self) -> Option<Outgoing> {
+        if !std::mem::take(&mut self.folds_owed) || self.app.editor().history.gesture_open() {
+            return None;
+        }
+        self.told_version = None;
+        let defer = std::mem::replace(&mut self.defer_folds, false);
+        let state = self.status_if_changed();
+        self.defer_folds = defer;
+        state.map(Outgoing::Text)
     }
 
     /// The viewer (its last frame).
@@ -254,7 +289,10 @@ impl Session {
         if self.told_version == Some(key) {
             return None;
         }
-        let folds = (!key.1).then(|| self.folds.folds(&h.current().doc.layers));
+        let want_folds = !key.1;
+        self.folds_owed = want_folds && self.defer_folds;
+        let folds =
+            (want_folds && !self.defer_folds).then(|| self.folds.folds(&h.current().doc.layers));
         let (can_undo, can_redo) = h.can_undo_redo();
         let status = Status {
             picture: h.current(),
@@ -266,6 +304,7 @@ impl Session {
         };
         self.told_version = Some(key);
         let mut state = status.to_json();
+        state["folds_to_come"] = self.folds_owed.into();
         files::describe(&files, &mut state);
         state["backdrops"] = backdrop::describe(&h.current().backdrops, |p| app.folder.name_of(p));
         Some(state.to_string())
@@ -514,6 +553,59 @@ mod tests {
         );
         session.handle_texts(&[r#"{"type":"end_gesture"}"#.to_string()]);
         assert_eq!(session.viewer.shown().unwrap().2, exact_render(&session));
+    }
+
+    /// The state messages among `out`, parsed.
+    fn states(out: &[Outgoing]) -> Vec<serde_json::Value> {
+        out.iter()
+            .filter_map(|m| match m {
+                Outgoing::Text(t) => serde_json::from_str::<serde_json::Value>(t).ok(),
+                _ => None,
+            })
+            .filter(|v| v["type"] == "state")
+            .collect()
+    }
+
+    #[test]
+    fn a_deferring_session_sends_the_folds_after_the_frame() {
+        let app = Arc::clone(&colourful_grid_session().app);
+        let mut session = Session::deferring_folds(app);
+        let view = r#"{"type":"view","width":64,"height":64,"view":[-10,-10,110,110]}"#;
+        let first = states(&session.handle_texts(&[view.to_string()]));
+        assert_eq!(first[0]["folds_checked"], false);
+        assert_eq!(first[0]["folds_to_come"], true);
+        let Some(Outgoing::Text(owed)) = session.owed_folds() else {
+            panic!("no state with the folds")
+        };
+        let owed: serde_json::Value = serde_json::from_str(&owed).unwrap();
+        assert_eq!(
+            (&owed["folds_checked"], &owed["folds_to_come"]),
+            (&true.into(), &false.into())
+        );
+        assert!(session.owed_folds().is_none(), "the folds sent twice");
+
+        // Folded: point 12 dragged across its neighbours. While the gesture is open nothing is
+        // owed; its end owes the folds, which then show the fold.
+        let step = r#"{"type":"edit","gesture":4,"op":{"op":"move_points","layer":0,"points":[12],"dx":60,"dy":0}}"#;
+        let during = states(&session.handle_texts(&[step.to_string()]));
+        assert_eq!(during[0]["folds_to_come"], false);
+        assert!(!session.owes_folds());
+        let end = states(&session.handle_texts(&[r#"{"type":"end_gesture"}"#.to_string()]));
+        assert_eq!(end[0]["folds_to_come"], true);
+        let Some(Outgoing::Text(owed)) = session.owed_folds() else {
+            panic!("no state with the folds")
+        };
+        let owed: serde_json::Value = serde_json::from_str(&owed).unwrap();
+        let folds = owed["layers"][0]["folds"].as_array().unwrap();
+        assert!(!folds.is_empty(), "the fold is not reported");
+
+        // A session that does not defer (the HTTP API's) gives the folds at once.
+        let app = Arc::clone(&session.app);
+        let mut plain = Session::new(app);
+        let now = states(&plain.handle_texts(&[r#"{"type":"state"}"#.to_string()]));
+        assert_eq!(now[0]["folds_checked"], true);
+        assert!(!now[0]["layers"][0]["folds"].as_array().unwrap().is_empty());
+        assert!(plain.owed_folds().is_none());
     }
 
     #[test]

@@ -131,11 +131,12 @@ pub async fn settle(client: &Client) {
         let ready = js(
             client,
             "const g = window.gradmesh; return !!g && g.state !== null && g.framesReceived > 0 \
-             && !g.busy && g.pending.length === 0 && !g.overlayQueued;",
+             && !g.busy && g.pending.length === 0 && !g.overlayQueued && !g.foldsToCome;",
         )
         .await;
         if ready == json!(true) {
-            // Each answer ends with "done", after its frame and state: all has arrived.
+            // Each answer ends with "done", after its frame and state, and the folds a
+            // state left out have come in the next: all has arrived.
             return;
         }
         assert!(Instant::now() < deadline, "the page did not settle");
