@@ -5,9 +5,9 @@ use std::sync::Arc;
 
 use crate::mesh::GradientMesh;
 
-use super::adaptive;
-use super::layer;
 use super::options::RenderOptions;
+use super::tessellate::adaptive;
+use super::tessellate::layer;
 use crate::colour::gamut::{BlendSpace, GamutMapping};
 use crate::limit_surface::patches::ShapeCache;
 
@@ -63,7 +63,7 @@ pub(super) struct LastImage {
     /// A `Vec<P>` of the [`OutputPixel`] type it was drawn in.
     pub(super) pixels: Box<dyn std::any::Any + Send + Sync>,
     /// Per band, then per layer: the farthest an outline pixel's colour was taken from (the
-    /// nearest boundary point, see [`nearest`]); negative infinity where none was.
+    /// nearest boundary point, see [`nearest`](super::tessellate::nearest)); negative infinity where none was.
     pub(super) reach: Vec<f64>,
 }
 

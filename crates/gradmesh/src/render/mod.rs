@@ -90,30 +90,16 @@
 //! # Ok::<(), gradmesh::Error>(())
 //! ```
 
-mod adaptive;
+mod arrays;
 mod cache;
-mod classic;
-mod clip;
 mod composite;
-mod coverage;
-mod face_plans;
 mod info;
-mod layer;
-mod measure;
-mod nearest;
 mod options;
-mod outline;
 mod output;
-mod over;
-mod overlay;
-mod patches;
-mod png_deflate;
-mod quadratic;
-mod stitch;
-mod triangles;
-#[cfg(target_arch = "x86_64")]
-#[allow(unsafe_code)]
-mod wide_vectors;
+mod plan;
+mod raster;
+mod sources;
+mod tessellate;
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -132,20 +118,24 @@ pub use crate::view::{
     MIN_RELATIVE_PIXEL_SIZE,
 };
 pub use cache::RenderCache;
+pub use composite::over::CanvasPixel;
 pub use info::{LayerInfo, LayerTimings, RenderInfo, RenderTimings};
 pub use options::{RenderOptions, DRAFT_LOOSENING};
-pub use output::{
+pub use output::overlay::draw_outlines;
+pub use output::pixels::{
     encode_png, encode_png_rgba16, encode_png_rgba8, write_png, write_png_rgba16, write_png_rgba8,
     write_png_rgba8_with, Image, OutputPixel, PngCompression, PngDepth,
 };
-pub use over::CanvasPixel;
-pub use overlay::draw_outlines;
 
 use crate::limit_surface::patches::ShapeCache;
 use crate::view::ToPixels;
 use cache::{LastImage, MAX_CACHED_SHAPES};
-use composite::{draw_band, Band, Scratch};
-use layer::{Columns, DrawableLayer, BAND};
+use composite::band::{draw_band, Band, Scratch};
+use composite::over;
+#[cfg(target_arch = "x86_64")]
+use composite::wide_vectors;
+use sources::{classic, patches};
+use tessellate::layer::{self, Columns, DrawableLayer, BAND};
 
 /// Renders `doc` into a new `f32` image: straight alpha, sRGB-encoded colour.
 pub fn render_document(doc: &Document, opts: &RenderOptions) -> Result<Image, Error> {
@@ -723,19 +713,6 @@ impl BandDrawer<'_> {
             }),
         }
     }
-}
-
-/// `[f(0), f(1), f(2)]`. Written out: in the hottest loops `array::map` and `array::from_fn`
-/// with closures were left as chains of calls (seen with cachegrind).
-#[inline(always)]
-pub(crate) fn each3<T>(mut f: impl FnMut(usize) -> T) -> [T; 3] {
-    [f(0), f(1), f(2)]
-}
-
-/// `[f(0), f(1), f(2), f(3)]` (see [`each3`]).
-#[inline(always)]
-pub(crate) fn each4<T>(mut f: impl FnMut(usize) -> T) -> [T; 4] {
-    [f(0), f(1), f(2), f(3)]
 }
 
 /// [`draw_band`] compiled for the x86-64-v3 level (AVX2, FMA, BMI) where the CPU has it, else

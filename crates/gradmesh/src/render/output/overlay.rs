@@ -4,11 +4,11 @@ use crate::error::{Error, ErrorKind};
 use crate::mesh::Document;
 use crate::refine::Refinement;
 
-use super::coverage::{Accumulator, Line};
-use super::outline::outline;
-use super::output::Image;
-use super::RenderOptions;
+use super::pixels::Image;
 use crate::limit_surface::boundary::boundary_loops;
+use crate::render::options::RenderOptions;
+use crate::render::raster::coverage::{Accumulator, Line};
+use crate::render::tessellate::outline::outline;
 use crate::view::ToPixels;
 
 /// The colour of the outline: near-black, opaque (sRGB).

@@ -1,9 +1,9 @@
 //! The one place with `unsafe` code: calling [`draw_band`] (and the gamut mapping of many
 //! colours) compiled for x86-64-v3, which is sound only on a CPU that has those instructions,
 //! after checking that it does.
-use super::composite::{draw_band as draw_band_inlined, Band, Scratch};
-use super::output::OutputPixel;
+use super::band::{draw_band as draw_band_inlined, Band, Scratch};
 use crate::colour::gamut::GamutMapping;
+use crate::render::output::pixels::OutputPixel;
 
 /// Whether the CPU has every feature [`draw_band_v3`] is compiled for (detected once, then
 /// read from a cache). Tests can turn the wide path off to compare the two.

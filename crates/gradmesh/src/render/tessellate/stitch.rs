@@ -10,12 +10,14 @@ use rayon::prelude::*;
 use crate::topology::Topology;
 use crate::validate::VertexData;
 
-use super::face_plans::{each_face, edge_counts, CellOrders, FacePlanner, FacePlans, Order, Plan};
 use super::nearest::Segment;
-use super::quadratic::{chord_node, screen_gradient, Cell, Quadratic};
-use super::triangles::{snap, Bounds, Triangle, UNBOUNDED};
-use super::{each3, each4};
 use crate::limit_surface::patches::Grid;
+use crate::render::arrays::{each3, each4};
+use crate::render::plan::face_plans::{
+    each_face, edge_counts, CellOrders, FacePlanner, FacePlans, Order, Plan,
+};
+use crate::render::plan::quadratic::{chord_node, screen_gradient, Cell, Quadratic};
+use crate::render::raster::triangles::{snap, Bounds, Triangle, UNBOUNDED};
 use crate::view::ToPixels;
 
 /// The grid position of parameter `s` (`0..=m`) along side `k` of a face, from its corner `k`
@@ -37,7 +39,7 @@ fn mean(a: &VertexData, b: &VertexData) -> [f64; 4] {
 
 /// The bounds of the colours of the base level's points `data` (whose convex hull holds the
 /// limit surface), when some face is quadratic: quadratic triangles are clamped to them.
-pub(super) fn colour_bounds(plans: &[Arc<Plan>], data: &[VertexData]) -> Option<Bounds> {
+pub(crate) fn colour_bounds(plans: &[Arc<Plan>], data: &[VertexData]) -> Option<Bounds> {
     plans.iter().any(|p| p.order == Order::Quadratic).then(|| {
         let mut b = [[f32::INFINITY; 4], [f32::NEG_INFINITY; 4]];
         for p in data {
@@ -63,7 +65,7 @@ struct EdgeOwner {
 }
 
 /// The balanced plans of a layer's faces and the samples their edges and vertices share.
-pub(super) struct Stitching<'a> {
+pub(crate) struct Stitching<'a> {
     t: &'a Topology,
     plans: &'a [Arc<Plan>],
     orders: &'a CellOrders,
@@ -116,7 +118,7 @@ impl<'a> Stitching<'a> {
         let edge_owners = edge_owners(t, plans, &edge_cells);
         let vertex_samples = vertex_samples(t, plans);
         // An edge is quadratic where every face on it is: its nodes are then the owner's finer
-        // samples moved to the chords' midpoints (see [`super::quadratic`]), which both sides
+        // samples moved to the chords' midpoints (see `plan::quadratic`), which both sides
         // compute alike; elsewhere they are the mean of the segment's ends, the colour a
         // linear face (or its fan) draws along it.
         let edge_quadratic: Vec<bool> = (0..t.edge_count())
@@ -603,9 +605,9 @@ impl<'s, 'a> FaceDrawing<'s, 'a> {
 
 /// Whether points (pixels) surely lie between two adjacent columns, or two adjacent rows, of
 /// pixel centres, so that no triangle through them covers a centre. Cheap, and sure: the
-/// margin covers the snapping that the exact test (in [`super::triangles::screen_triangle_px`])
+/// margin covers the snapping that the exact test (in [`screen_triangle_px`](crate::render::raster::triangles::screen_triangle_px))
 /// works on.
-pub(super) fn between_pixel_centres<const N: usize>(p: [[f64; 2]; N]) -> bool {
+pub(crate) fn between_pixel_centres<const N: usize>(p: [[f64; 2]; N]) -> bool {
     // A sixty-fourth of a pixel: far more than the snapping moves a point.
     const MARGIN: f64 = 1.0 / 64.0;
     // Floors without the library call.
@@ -629,7 +631,7 @@ pub(super) fn between_pixel_centres<const N: usize>(p: [[f64; 2]; N]) -> bool {
 
 /// The triangle through three limit samples, in pixels, quadratic with the side nodes `mids`
 /// (within the colour `bounds`), if it may cover a pixel centre of the image (see
-/// [`super::triangles::screen_triangle_px`]).
+/// [`screen_triangle_px`](crate::render::raster::triangles::screen_triangle_px)).
 #[inline]
 fn screen_triangle(
     d: [&VertexData; 3],
@@ -640,5 +642,5 @@ fn screen_triangle(
 ) -> Option<Triangle> {
     let exact = each3(|k| xf.apply(d[k][0], d[k][1]));
     let attr = each3(|k| [d[k][2], d[k][3], d[k][4], d[k][5]]);
-    super::triangles::screen_triangle_px(exact, attr, mids, bounds, size)
+    crate::render::raster::triangles::screen_triangle_px(exact, attr, mids, bounds, size)
 }

@@ -9,7 +9,7 @@
 
 use std::sync::Arc;
 
-use super::each4;
+use crate::render::arrays::each4;
 
 /// Sub-pixel steps per pixel.
 pub(crate) const SUBPIXEL: i64 = 256;
@@ -709,7 +709,7 @@ impl Triangle {
 /// The triangle through three points (pixels) with attributes `attr` (and quadratic, with the
 /// side nodes `mids`, and the layer's colour `bounds`), snapped, if it may cover a pixel centre
 /// of a `size` image.
-pub(super) fn screen_triangle_px(
+pub(crate) fn screen_triangle_px(
     exact: [[f64; 2]; 3],
     attr: [[f64; 4]; 3],
     mids: Option<[[f64; 4]; 3]>,
@@ -726,7 +726,7 @@ pub(super) fn screen_triangle_px(
 /// no pixel centre of a `size` image: it lies beside the image, or no column of pixel centres
 /// runs between its leftmost and rightmost corner, or no row between its lowest and highest
 /// (at deep levels most cells are under a pixel).
-pub(super) fn snapped_if_visible(exact: [[f64; 2]; 3], size: (i64, i64)) -> Option<[[i64; 2]; 3]> {
+pub(crate) fn snapped_if_visible(exact: [[f64; 2]; 3], size: (i64, i64)) -> Option<[[i64; 2]; 3]> {
     let (w, h) = size;
     let (xmax, ymax) = (w * SUBPIXEL, h * SUBPIXEL);
     let snapped = |p: [f64; 2]| Some([snap(p[0])?, snap(p[1])?]);
@@ -905,7 +905,7 @@ mod tests {
 
     #[test]
     fn fast_floor_division_is_exact() {
-        let mut next = super::super::test_random(0x9e37_79b9_7f4a_7c15);
+        let mut next = crate::render::test_random(0x9e37_79b9_7f4a_7c15);
         for _ in 0..200_000 {
             let r = next();
             // Numerators of every size up to 2^55, both signs; denominators 256 .. 2^35.
@@ -923,7 +923,7 @@ mod tests {
     #[test]
     fn small_and_i128_spans_agree() {
         // Awkward vertices, both orientations, rows through and beside them.
-        let mut bits = super::super::test_random(0x2545_f491);
+        let mut bits = crate::render::test_random(0x2545_f491);
         let mut next = || (bits() % 20_000) as f64 / 37.0 - 20.0;
         for _ in 0..2000 {
             let v = [0, 1, 2].map(|_| p(next(), next()));
@@ -945,7 +945,7 @@ mod tests {
     fn spans_found_together_match_i128_spans() {
         // Triangles of every size from a pixel to far beyond the double-precision path's
         // range, near and far from the origin, with rows through, beside and far from them.
-        let mut bits = super::super::test_random(0x9e37_79b9);
+        let mut bits = crate::render::test_random(0x9e37_79b9);
         let (mut checked_f64, mut checked_integers) = (0, 0);
         for n in 0..3000 {
             let scale = [1.0, 50.0, 3000.0, 1e6, 3e9][n % 5];

@@ -7,18 +7,18 @@ use std::ops::Range;
 
 use crate::colour::ColourSpace;
 
-use super::coverage;
-use super::each4;
-use super::layer::{Clip, DrawableLayer, BAND};
-use super::options::RenderOptions;
-use super::output;
-use super::output::OutputPixel;
-use super::triangles;
 use crate::colour::gamut::GamutMapping;
 use crate::colour::gamut::{self, BlendSpace, RUN};
+use crate::render::arrays::each4;
+use crate::render::options::RenderOptions;
+use crate::render::output::pixels as output;
+use crate::render::output::pixels::OutputPixel;
+use crate::render::raster::coverage;
+use crate::render::raster::triangles;
+use crate::render::tessellate::layer::{Clip, DrawableLayer, BAND};
 
 /// Per-thread working buffers, fully reset by each band that uses them.
-pub(super) struct Scratch {
+pub(crate) struct Scratch {
     attributes: Vec<[f32; 4]>,
     covered: Vec<bool>,
     /// Pixels of the band that layers above have made opaque (a byte each: the span loop
@@ -47,7 +47,7 @@ const KEEP_SCRATCH_MAX_WIDTH: usize = 8192;
 
 impl Scratch {
     /// Runs `f` with this thread's scratch for rows `w` pixels wide.
-    pub(super) fn with<R>(w: usize, f: impl FnOnce(&mut Scratch) -> R) -> R {
+    pub(crate) fn with<R>(w: usize, f: impl FnOnce(&mut Scratch) -> R) -> R {
         // Taken out of the slot while in use: a band that re-entered here (draw_band does not
         // call into rayon) or one that panicked leaves no half-used scratch behind.
         let kept = SCRATCH.with(|cell| cell.take());
@@ -100,24 +100,24 @@ struct Run {
 
 /// One band of the image to draw: columns `columns` of rows `index * BAND ..`, whose pixels
 /// are `out` (the others are left as they are).
-pub(super) struct Band<'a, P> {
+pub(crate) struct Band<'a, P> {
     /// Whether this is the x86-64-v3 compilation, whose vectors some loops are written for.
-    pub(super) wide: bool,
-    pub(super) index: usize,
-    pub(super) columns: Range<usize>,
-    pub(super) out: &'a mut [P],
-    pub(super) layers: &'a [&'a DrawableLayer],
-    pub(super) opts: &'a RenderOptions,
-    pub(super) background: Option<[f32; 4]>,
+    pub(crate) wide: bool,
+    pub(crate) index: usize,
+    pub(crate) columns: Range<usize>,
+    pub(crate) out: &'a mut [P],
+    pub(crate) layers: &'a [&'a DrawableLayer],
+    pub(crate) opts: &'a RenderOptions,
+    pub(crate) background: Option<[f32; 4]>,
     /// Receives, per layer, the farthest an outline pixel's colour was taken from.
-    pub(super) reach: &'a mut [f64],
+    pub(crate) reach: &'a mut [f64],
 }
 
 /// Draws every layer into a band. Inlined into the two compilations of
 /// [`draw_band_dispatched`], with the hot functions it calls: each step below is
 /// `#[inline(always)]` so that it is compiled for the wide vectors too.
 #[inline(always)]
-pub(super) fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
+pub(crate) fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {
     let Band {
         wide,
         index: band,

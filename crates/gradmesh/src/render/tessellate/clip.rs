@@ -9,7 +9,7 @@
 
 use kurbo::{Affine, BezPath, PathEl, Point};
 
-use super::coverage::Line;
+use crate::render::raster::coverage::Line;
 use crate::view::ToPixels;
 
 /// Flattening tolerance of a clip outline (pixels), as for a layer's own outline.

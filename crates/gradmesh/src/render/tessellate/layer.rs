@@ -17,14 +17,17 @@ use crate::validate::{attributes, BaseMesh, VertexData, COLOUR, X, Y};
 
 use super::adaptive;
 use super::clip::clip_lines;
-use super::coverage::Line;
-use super::measure::{measure, Measure, Thresholds, MIN_QUAD_PX};
 use super::nearest::{NearestSegments, Segment};
 use super::outline::outline;
-use super::triangles::{screen_triangle_px, snap, Bounds, Triangle, TriangleList, UNBOUNDED};
-use super::{LayerInfo, LayerTimings, RenderOptions};
 use crate::limit_surface::boundary::boundary_loops;
 use crate::limit_surface::patches::ShapeCache;
+use crate::render::info::{LayerInfo, LayerTimings};
+use crate::render::options::RenderOptions;
+use crate::render::plan::measure::{measure, Measure, Thresholds, MIN_QUAD_PX};
+use crate::render::raster::coverage::Line;
+use crate::render::raster::triangles::{
+    screen_triangle_px, snap, Bounds, Triangle, TriangleList, UNBOUNDED,
+};
 use crate::view::ToPixels;
 
 /// Rows per band: the unit of parallel work.
@@ -184,7 +187,7 @@ impl DrawableLayer {
     /// - from the leftmost to the rightmost outline line that differs in any bit (coverage is
     ///   a prefix sum along the row, in fixed point: to the left of a change it is the same sum,
     ///   and to the right too, to the unit, since both outlines are closed: see
-    ///   [`super::coverage`]);
+    ///   [`coverage`](crate::render::raster::coverage));
     /// - within `reach[band]` of a boundary segment that changed (the farthest its outline
     ///   pixels there took their colour from when last drawn);
     ///

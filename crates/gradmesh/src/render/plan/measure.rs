@@ -9,12 +9,12 @@ use crate::colour::{ColourSpace, Matrix3};
 use crate::topology::Topology;
 use crate::validate::VertexData;
 
-use super::options::DRAFT_LOOSENING;
-use super::{each3, each4, RenderOptions};
+use crate::render::arrays::{each3, each4};
+use crate::render::options::{RenderOptions, DRAFT_LOOSENING};
 use crate::view::ToPixels;
 
 /// Colour errors count in quads at least this wide (diagonal, pixels) in the fast path...
-pub(super) const MIN_QUAD_PX: f64 = 1.0;
+pub(crate) const MIN_QUAD_PX: f64 = 1.0;
 /// ...and in smaller cells of the fast path's faces that hold a pixel centre, down to this
 /// size. Where the surface folds, the colour error of linear pieces only falls by about 0.6 a
 /// level (the map to the screen is singular at the crease), and without a floor a fold can
@@ -29,7 +29,7 @@ const ADAPTIVE_MIN_COUNTED_PX: f64 = 0.2;
 /// reference mode cannot tell apart (limits 0.5 worst and 0.05 mean CIEDE2000).
 const ADAPTIVE_COLOUR_MARGIN: f64 = 0.75;
 /// What the fast path asks of the triangles (the reference mode has its own, stricter ones).
-pub(super) struct Thresholds {
+pub(crate) struct Thresholds {
     /// Largest quad diagonal, pixels.
     pub quad: f64,
     /// Largest colour error.
@@ -49,7 +49,7 @@ pub(super) struct Thresholds {
 }
 
 impl Thresholds {
-    pub(super) fn new(opts: &RenderOptions, space: ColourSpace) -> Thresholds {
+    pub(crate) fn new(opts: &RenderOptions, space: ColourSpace) -> Thresholds {
         let loosening = if opts.draft { DRAFT_LOOSENING } else { 1.0 };
         Thresholds {
             quad: opts.max_quad_px * loosening.sqrt(),
@@ -67,7 +67,7 @@ impl Thresholds {
 /// How well the triangles of one level render the limit surface, over the quads that reach
 /// the image.
 #[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Measure {
+pub(crate) struct Measure {
     /// Largest quad diagonal, pixels.
     pub extent: f64,
     /// Largest colour error, approximately CIE Lab units (opacity counts 100 per unit).
@@ -157,7 +157,7 @@ fn interpolate(p: [[f64; 2]; 3], c: [[f64; 4]; 3], x: [f64; 2]) -> [f64; 4] {
 /// extraordinary and degenerate points (a handle of length zero makes a sharp colour step, for
 /// example), where uniform refinement converges only linearly and would refine the whole layer
 /// for a few pixels.
-pub(super) fn measure(
+pub(crate) fn measure(
     t: &Topology,
     lim: &[VertexData],
     lim1: &[VertexData],
@@ -195,7 +195,7 @@ pub(super) fn measure(
 /// The samples of one quad that [`measure_quad`] needs: the limit data at its corners (wound),
 /// at its centre and at the midpoints of its sides (side `k` from corner `k` to `k + 1`), and
 /// which sides lie on the outline.
-pub(super) struct QuadSamples<'a> {
+pub(crate) struct QuadSamples<'a> {
     pub corners: [&'a VertexData; 4],
     pub centre: &'a VertexData,
     pub mids: [&'a VertexData; 4],
@@ -208,7 +208,7 @@ pub(super) struct QuadSamples<'a> {
 /// The colour error of `shown` against the limit `sample`: exact, or through the derivative
 /// `jacobian` of the working space to Lab at the sample. Errors worth measuring are a few Lab
 /// units, where the two agree to a fraction of a percent.
-pub(super) fn sample_error(
+pub(crate) fn sample_error(
     space: ColourSpace,
     sample: [f64; 4],
     shown: [f64; 4],
@@ -230,7 +230,7 @@ pub(super) fn sample_error(
 /// `min_quad` still counts when the quad's box holds a pixel centre (and it is at least
 /// [`ADAPTIVE_MIN_COUNTED_PX`] across): such a quad is not refined along with larger ones
 /// elsewhere, as in a uniform level.
-pub(super) fn measure_quad(
+pub(crate) fn measure_quad(
     q: &QuadSamples,
     xf: &ToPixels,
     size: (f64, f64),

@@ -1,4 +1,4 @@
-//! Planning the faces of a layer's base level for [`super::adaptive`]: how many cells a side
+//! Planning the faces of a layer's base level for [`adaptive`](crate::render::tessellate::adaptive): how many cells a side
 //! each face takes, and whether its cells interpolate colour linearly or quadratically; then
 //! the 2:1 balance between neighbouring faces.
 
@@ -11,12 +11,12 @@ use crate::level::Level;
 use crate::topology::Topology;
 use crate::validate::VertexData;
 
-use super::each4;
 use super::measure::{measure_quad, Measure, QuadSamples, Thresholds};
 use super::quadratic::{measure_cells, Cell};
 use crate::limit_surface::patches::{
     regular_corners, regular_patch_with, ControlGrid, Grid, LocalPatch, ShapeCache,
 };
+use crate::render::arrays::each4;
 use crate::view::ToPixels;
 
 /// Quadratic colour is tried on a face only while its linear error is at most this many times
@@ -157,7 +157,7 @@ fn cell_order(n: usize) -> Vec<Cell> {
 }
 
 /// [`cell_order`] for every power of two up to a limit, each built on first use.
-pub(super) struct CellOrders(Vec<OnceLock<Vec<Cell>>>);
+pub(crate) struct CellOrders(Vec<OnceLock<Vec<Cell>>>);
 
 impl CellOrders {
     fn new(n_max: usize) -> CellOrders {
@@ -264,7 +264,7 @@ fn needs_jacobians(space: ColourSpace) -> bool {
 
 /// How a face's cells interpolate colour.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Order {
+pub(crate) enum Order {
     Linear,
     /// Six-node triangles ([`super::quadratic`]).
     Quadratic,
@@ -272,7 +272,7 @@ pub(super) enum Order {
 
 /// One face's plan: cells a side, its grid, and how it measured.
 #[derive(Clone)]
-pub(super) struct Plan {
+pub(crate) struct Plan {
     pub n: usize,
     /// The grid of `n` cells a side; empty where it is the even points of `finer` (a regular
     /// patch's grids share their points bit for bit), which saves a quadratic face an
@@ -403,7 +403,7 @@ pub(crate) enum CachedPlan {
 /// The plans of a layer's last preparation a planning may take: those of the faces not
 /// marked in `again`.
 #[derive(Clone, Copy)]
-pub(super) struct EarlierPlans<'a> {
+pub(crate) struct EarlierPlans<'a> {
     pub plans: &'a [CachedPlan],
     pub again: &'a [bool],
 }
@@ -416,13 +416,13 @@ impl<'a> EarlierPlans<'a> {
 
 /// An irregular face's local refinement, shared by the faces refined together, and the face's
 /// root there.
-pub(super) type SharedPatch = (Arc<Mutex<LocalPatch>>, usize);
+pub(crate) type SharedPatch = (Arc<Mutex<LocalPatch>>, usize);
 
 /// Plans of one group of irregular faces: face, plan, local refinement and root there.
 type GroupPlans = Vec<(usize, Arc<Plan>, Arc<Mutex<LocalPatch>>, usize)>;
 
 /// Every face's plan.
-pub(super) struct FacePlans {
+pub(crate) struct FacePlans {
     pub plans: Vec<Arc<Plan>>,
     /// Each irregular face's local refinement, kept for the counts balancing asks for: cutting
     /// out and refining a face's neighbourhood alone again cost Glasses a tenth of a
@@ -446,7 +446,7 @@ impl FacePlans {
 }
 
 /// What planning reads: the base level, its data, and the measures' thresholds.
-pub(super) struct FacePlanner<'a> {
+pub(crate) struct FacePlanner<'a> {
     level: &'a Level,
     t: &'a Topology,
     data: &'a [VertexData],
@@ -755,7 +755,7 @@ impl<'a> FacePlanner<'a> {
     /// finest edge (2:1 balance with the faces' own densities: the faces around a deeply
     /// refined spot, often a fold near a singular point, follow its shape closely). A coarser
     /// face then fans its boundary cells out to the edge's extra samples (see
-    /// [`super::stitch`]).
+    /// [`stitch`](crate::render::tessellate::stitch)).
     pub fn balance(&self, faces: &mut FacePlans) -> Option<()> {
         let t = self.t;
         let own_edge_cells = edge_counts(t, &faces.plans);
@@ -833,7 +833,7 @@ impl<'a> FacePlanner<'a> {
 }
 
 /// Cells per edge of `t`: the most of its faces'.
-pub(super) fn edge_counts(t: &Topology, plans: &[Arc<Plan>]) -> Vec<usize> {
+pub(crate) fn edge_counts(t: &Topology, plans: &[Arc<Plan>]) -> Vec<usize> {
     let nf = t.face_count();
     // The counts side by side first: read through each plan's pointer, edge by edge, they
     // would be a cache miss each.
@@ -870,7 +870,7 @@ fn folded(t: &Topology, turns: &[u8], f: usize) -> bool {
 /// written straight into place (an indexed collect): collected as an `Option` of a vector,
 /// rayon gathered them in a list of pieces and copied them twice more, which for 90,000 faces
 /// of plans was a tenth of planning.
-pub(super) fn each_face<T: Send>(
+pub(crate) fn each_face<T: Send>(
     nf: usize,
     f: impl Fn(usize) -> Option<T> + Sync + Send,
 ) -> Option<Vec<T>> {

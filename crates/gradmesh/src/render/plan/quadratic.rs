@@ -18,18 +18,18 @@
 
 use crate::validate::VertexData;
 
-use super::each4;
 use super::measure::sample_error;
 use crate::colour::{ColourSpace, Matrix3};
+use crate::render::arrays::each4;
 use crate::view::ToPixels;
 
 /// The screen gradient of the four attributes: `grad[k] = [d/dx, d/dy]`.
-pub(super) type Gradient = [[f64; 2]; 4];
+pub(crate) type Gradient = [[f64; 2]; 4];
 
 /// A quadratic triangle in screen coordinates (pixels, double precision): corners `p` with
 /// attributes `c`, and the attributes `m[k]` at the midpoint of the side from `p[k]` to
 /// `p[k + 1]`.
-pub(super) struct Quadratic {
+pub(crate) struct Quadratic {
     pub p: [[f64; 2]; 3],
     pub c: [[f64; 4]; 3],
     pub m: [[f64; 4]; 3],
@@ -60,7 +60,7 @@ impl Quadratic {
 }
 
 /// See [`Quadratic::evaluator`].
-pub(super) struct QuadraticEvaluator<'a> {
+pub(crate) struct QuadraticEvaluator<'a> {
     q: &'a Quadratic,
     l1: [f64; 2],
     l2: [f64; 2],
@@ -98,7 +98,7 @@ fn well_conditioned(det: f64, scale: f64) -> bool {
 
 /// The attributes at the midpoint of the chord from `a` to `b` (pixels), from the surface's
 /// sample `mid` there in parameter and the screen gradient `grad` at it.
-pub(super) fn chord_node(
+pub(crate) fn chord_node(
     a: [f64; 2],
     b: [f64; 2],
     mid: &VertexData,
@@ -113,7 +113,7 @@ pub(super) fn chord_node(
 /// The screen gradient of the attributes at point `(i, j)` of a face's grid `g` of `side`
 /// points a side (at least three), by differences of second order (one-sided on the face's
 /// border); zero where the map to the screen is singular there.
-pub(super) fn screen_gradient(
+pub(crate) fn screen_gradient(
     g: &[VertexData],
     side: usize,
     (i, j): (usize, usize),
@@ -154,7 +154,7 @@ pub(super) fn screen_gradient(
 }
 
 /// The corners of a cell (grid coordinates, wound like the face).
-pub(super) type Cell = [(usize, usize); 4];
+pub(crate) type Cell = [(usize, usize); 4];
 
 /// The largest colour error of the quadratic triangles `(0, 1, 2)` and `(0, 2, 3)` of the
 /// `cells` of a face's grid of `n` cells a side, whose nodes come from its grid `g2` of `2 n`
@@ -165,7 +165,7 @@ pub(super) type Cell = [(usize, usize); 4];
 /// centres are read), from [`super::face_plans`]'s linear measure. Infinite where a counted
 /// triangle has no area on the screen.
 #[allow(clippy::too_many_arguments)]
-pub(super) fn measure_cells(
+pub(crate) fn measure_cells(
     g2: &[VertexData],
     g4: &[VertexData],
     n: usize,

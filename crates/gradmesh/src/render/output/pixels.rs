@@ -245,7 +245,7 @@ pub fn encode_png(image: &Image, depth: PngDepth) -> Result<Vec<u8>, Error> {
     Ok(out)
 }
 
-/// Encodes 8-bit RGBA (as [`super::render_document_into`] writes it: straight alpha,
+/// Encodes 8-bit RGBA (as [`crate::render::render_document_into`] writes it: straight alpha,
 /// sRGB-encoded, rows top to bottom) as a PNG marked as sRGB. Rendering straight into bytes
 /// skips the `f32` image, four times the memory of the output.
 pub fn encode_png_rgba8(width: u32, height: u32, data: &[u8]) -> Result<Vec<u8>, Error> {

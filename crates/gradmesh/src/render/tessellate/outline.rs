@@ -10,7 +10,7 @@
 use crate::level::Level;
 use crate::limit_surface::boundary::for_each_boundary_segment;
 
-use super::coverage::Line;
+use crate::render::raster::coverage::Line;
 
 /// Outline points are snapped to 2^-16 pixel, far below anything coverage can show.
 const OUTLINE_GRID: f64 = 65536.0;

@@ -24,14 +24,17 @@ use std::time::Instant;
 use kurbo::{BezPath, PathEl, Point};
 use rayon::prelude::*;
 
-use super::coverage::Line;
-use super::layer::{bin_triangles, visible_outline, DrawableLayer, LayerPreparation, BAND};
-use super::nearest::{NearestSegments, Segment};
-use super::triangles::{screen_triangle_px, Triangle, TriangleList, UNBOUNDED};
-use super::{LayerInfo, LayerTimings, RenderOptions};
 use crate::colour::ColourSpace;
 use crate::error::{Error, ErrorKind};
 use crate::formats::pdf::{Patch, ShadingFill};
+use crate::render::info::{LayerInfo, LayerTimings};
+use crate::render::options::RenderOptions;
+use crate::render::raster::coverage::Line;
+use crate::render::raster::triangles::{screen_triangle_px, Triangle, TriangleList, UNBOUNDED};
+use crate::render::tessellate::layer::{
+    bin_triangles, visible_outline, DrawableLayer, LayerPreparation, BAND,
+};
+use crate::render::tessellate::nearest::{NearestSegments, Segment};
 use crate::view::ToPixels;
 
 /// The widest a cell may be (pixels, along each parameter).

@@ -1,6 +1,6 @@
 //! The fast path's tessellation: each face of a low all-quad level gets its own grid density.
 //!
-//! 1. **Density** ([`super::face_plans`]). Each face of the base level ([`BASE_LEVEL`],
+//! 1. **Density** ([`face_plans`](crate::render::plan::face_plans)). Each face of the base level ([`BASE_LEVEL`],
 //!    shallower for meshes dense for the image: see [`base_level`]) is evaluated on grids of
 //!    `1, 2, 4, ..` cells a side ([`patches`](crate::limit_surface::patches): a B-spline patch where the face
 //!    is regular, local refinement elsewhere) until its cells pass the same measure as the
@@ -32,12 +32,12 @@ use crate::refine::{RefinedData, Refinement};
 use crate::topology::Topology;
 use crate::validate::VertexData;
 
-use super::face_plans::{CachedPlan, EarlierPlans, FacePlanner, FacePlans};
-use super::measure::{Measure, Thresholds};
 use super::nearest::Segment;
 use super::stitch::{colour_bounds, Stitching};
-use super::triangles::{Bounds, Triangle, TriangleList};
 use crate::limit_surface::patches::ShapeCache;
+use crate::render::plan::face_plans::{CachedPlan, EarlierPlans, FacePlanner, FacePlans};
+use crate::render::plan::measure::{Measure, Thresholds};
+use crate::render::raster::triangles::{Bounds, Triangle, TriangleList};
 use crate::view::ToPixels;
 
 /// The level whose faces get their own density: all quads, extraordinary vertices isolated,
@@ -87,14 +87,14 @@ fn covered_pixels(points: &[VertexData], xf: &ToPixels, size: (i64, i64)) -> usi
 }
 
 /// What the fast path produced for one layer.
-pub(super) struct Tessellation {
+pub(crate) struct Tessellation {
     /// The base level: the outline is taken from it.
     pub base_level: usize,
     /// The uniform level with the density of the finest face.
     pub level: usize,
     /// Cells drawn.
     pub quads: usize,
-    /// Whether some face reached [`super::RenderOptions::max_level`] before passing.
+    /// Whether some face reached [`RenderOptions::max_level`](crate::render::RenderOptions::max_level) before passing.
     pub capped: bool,
     /// The worst figures over the faces.
     pub measured: Measure,
@@ -112,7 +112,7 @@ pub(super) struct Tessellation {
 }
 
 /// The plans of a layer's faces at its last preparation, kept by a
-/// [`RenderCache`](super::RenderCache) for the next. A face's plan depends only on the
+/// [`RenderCache`](crate::render::RenderCache) for the next. A face's plan depends only on the
 /// topology and sharpness around it, the points of the faces that share a vertex with it (its
 /// patch's control points, or the neighbourhood its local refinement cuts out), the working
 /// space and the options (the same for every entry of a cache). So where the refinement kept
@@ -248,7 +248,7 @@ fn faces_to_plan_again(t: &Topology, old: &[VertexData], new: &[VertexData]) -> 
 
 /// What earlier preparations left that a layer's tessellation may take: the local refinements
 /// by shape (of all layers), and this layer's [`TessellationCache`] (with a
-/// [`RenderCache`](super::RenderCache); this tessellation's plans and triangles are then left
+/// [`RenderCache`](crate::render::RenderCache); this tessellation's plans and triangles are then left
 /// in their place).
 pub(crate) struct Caches<'a> {
     pub shapes: &'a ShapeCache,
@@ -259,7 +259,7 @@ pub(crate) struct Caches<'a> {
 /// `None` where the fast path does not apply (a face that is not a quad at the base level, a
 /// neighbourhood that is not a valid mesh on its own, semi-sharpness on the outline down to
 /// [`DEEPEST_BASE_LEVEL`]): the caller then refines uniformly.
-pub(super) fn tessellate(
+pub(crate) fn tessellate(
     refinement: &mut Refinement,
     data: &mut RefinedData,
     xf: &ToPixels,
@@ -495,7 +495,7 @@ fn figures(k0: usize, faces: &FacePlans) -> Figures {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::stitch::between_pixel_centres;
+    use crate::render::tessellate::stitch::between_pixel_centres;
     use crate::render::{RenderOptions, View};
     use crate::GradientMesh;
     use kurbo::Point;
@@ -560,7 +560,7 @@ mod tests {
                             let corners = tri.map(|k| quad[k]);
                             let size = (2048, 2048);
                             assert!(
-                                crate::render::triangles::snapped_if_visible(corners, size)
+                                crate::render::raster::triangles::snapped_if_visible(corners, size)
                                     .is_none(),
                                 "{corners:?} was skipped but may cover a pixel centre"
                             );

@@ -3,7 +3,7 @@
 //! Each band is drawn into a band-sized `f32` buffer and composited source-over onto the
 //! canvas's band; nothing the size of the image is allocated.
 
-use super::output::{dither_noise, OutputPixel};
+use crate::render::output::pixels::{dither_noise, OutputPixel};
 
 /// A channel type of a premultiplied canvas a picture can be composited over: `u8` or `u16`.
 pub trait CanvasPixel: OutputPixel {
@@ -28,7 +28,7 @@ impl CanvasPixel for u16 {
 /// Composites `band` (straight alpha, sRGB-encoded, as the renderer draws) over `canvas`
 /// (premultiplied), both rows `y0..` of an image `width` pixels wide. Pixels the band leaves
 /// clear keep their bits; the others are dithered (8-bit canvas) with the renderer's noise.
-pub(super) fn composite_band_over<P: CanvasPixel>(
+pub(crate) fn composite_band_over<P: CanvasPixel>(
     canvas: &mut [P],
     band: &[f32],
     (width, y0): (usize, usize),

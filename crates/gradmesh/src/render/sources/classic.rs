@@ -26,15 +26,18 @@ use std::time::Instant;
 use kurbo::{BezPath, CubicBez, ParamCurve, Point, Shape};
 use rayon::prelude::*;
 
-use super::clip::clip_lines;
-use super::layer::{bin_triangles, visible_outline, DrawableLayer, LayerPreparation, BAND};
-use super::nearest::{NearestSegments, Segment};
-use super::triangles::{screen_triangle_px, Triangle, TriangleList, UNBOUNDED};
-use super::{LayerInfo, LayerTimings, RenderOptions};
 use crate::colour::ColourSpace;
 use crate::error::{Error, ErrorKind};
 use crate::formats::svg::paint::{colour_lattices, Lattice, BICUBIC_SPLIT};
 use crate::formats::svg::{MeshFill, MeshGrid, MeshType};
+use crate::render::info::{LayerInfo, LayerTimings};
+use crate::render::options::RenderOptions;
+use crate::render::raster::triangles::{screen_triangle_px, Triangle, TriangleList, UNBOUNDED};
+use crate::render::tessellate::clip::clip_lines;
+use crate::render::tessellate::layer::{
+    bin_triangles, visible_outline, DrawableLayer, LayerPreparation, BAND,
+};
+use crate::render::tessellate::nearest::{NearestSegments, Segment};
 use crate::view::ToPixels;
 
 /// The widest a cell may be (pixels, along each parameter): colour is bilinear in the patch's
