@@ -165,8 +165,8 @@ function showMessage(text) {
 
 // ---- frames -------------------------------------------------------------------------------
 
-// A frame: "GMF1", then u32 frame number, width, height, run count; each run: first row,
-// row count, RGBA8 rows.
+// A frame: "GMF2", then u32 frame number, width, height, run count; each run: first row,
+// row count, first column, column count, then the RGBA8 pixels of that rectangle.
 function drawFrame(buffer) {
   const words = new DataView(buffer);
   const width = words.getUint32(8, true);
@@ -180,9 +180,11 @@ function drawFrame(buffer) {
   for (let r = 0; r < runs; r++) {
     const first = words.getUint32(at, true);
     const count = words.getUint32(at + 4, true);
-    at += 8;
-    const bytes = new Uint8ClampedArray(buffer, at, width * count * 4);
-    pictureContext.putImageData(new ImageData(bytes, width, count), 0, first);
+    const x = words.getUint32(at + 8, true);
+    const columns = words.getUint32(at + 12, true);
+    at += 16;
+    const bytes = new Uint8ClampedArray(buffer, at, columns * count * 4);
+    pictureContext.putImageData(new ImageData(bytes, columns, count), x, first);
     at += bytes.length;
   }
   editor.framesReceived++;

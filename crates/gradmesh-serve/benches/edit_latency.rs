@@ -233,6 +233,8 @@ fn steps() -> usize {
 fn report(name: &str, edit: &str, doc: &Document, t: Target, command: fn(Target, usize) -> String) {
     let mut session = session(doc);
     let n = steps();
+    let mut bytes: Vec<usize> = Vec::with_capacity(n);
+    let mut texts: Vec<usize> = Vec::with_capacity(n);
     let mut times: Vec<Duration> = (0..n)
         .map(|step| {
             let text = command(t, step + 1);
@@ -240,19 +242,41 @@ fn report(name: &str, edit: &str, doc: &Document, t: Target, command: fn(Target,
             let out = session.handle_texts(&[text]);
             let elapsed = start.elapsed();
             assert!(!out.iter().any(|m| matches!(m, Outgoing::Error(_))));
+            let frame: usize = (out.iter())
+                .filter(|m| matches!(m, Outgoing::Binary(_)))
+                .map(message_bytes)
+                .sum();
+            bytes.push(frame);
+            texts.push(out.iter().map(message_bytes).sum::<usize>() - frame);
             elapsed
         })
         .collect();
     times.sort();
+    bytes.sort();
+    texts.sort();
     let ms = |d: Duration| d.as_secs_f64() * 1e3;
     println!(
-        "{name} {edit} (layer {}, point {}), {n} steps at {WIDTH} px: median {:.2} ms, 95th {:.2} ms, worst {:.2} ms",
+        "{name} {edit} (layer {}, point {}), {n} steps at {WIDTH} px: median {:.2} ms, 95th {:.2} ms, \
+         worst {:.2} ms; medians of the bytes sent: frame {:.0} kB, state {:.0} kB",
         t.layer,
         t.point,
         ms(times[n / 2]),
         ms(times[(n * 95 / 100).min(n - 1)]),
-        ms(times[n - 1])
+        ms(times[n - 1]),
+        bytes[n / 2] as f64 / 1e3,
+        texts[n / 2] as f64 / 1e3
     );
+}
+
+/// The bytes of a message to the page.
+fn message_bytes(message: &Outgoing) -> usize {
+    match message {
+        Outgoing::Text(t) | Outgoing::Error(t) | Outgoing::Notice(t) | Outgoing::Select(t) => {
+            t.len()
+        }
+        Outgoing::Binary(b) => b.len(),
+        Outgoing::Done => 0,
+    }
 }
 
 /// The stages of one drag step, timed apart (the medians of the steps): applying the move and

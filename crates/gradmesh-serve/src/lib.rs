@@ -4,7 +4,7 @@
 //! per page; the page (plain HTML, CSS and JavaScript embedded in the binary) draws the
 //! control mesh over the picture and sends edits over a WebSocket. After each batch of edits
 //! the server renders the picture with gradmesh's renderer at the canvas's size and sends the
-//! rows that changed as raw RGBA8 (see [`viewer::encode_frame`]).
+//! rectangles that changed as raw RGBA8 (see [`viewer::encode_frame`]).
 //!
 //! The server listens on 127.0.0.1 only; every request needs the launch's random token, and
 //! requests whose `Host` or `Origin` is not this server are refused ([`security`]). It reads

@@ -286,7 +286,12 @@ impl Session {
         let h = &editor.history;
         let files = app.files();
         let key = (h.version(), h.gesture_open(), files.generation());
-        if self.told_version == Some(key) {
+        // While a gesture runs the page moves what it drags itself: the state goes with the
+        // gesture's first frame and with its end, not with every move.
+        let told_this_gesture = self
+            .told_version
+            .is_some_and(|told| told.1 && key.1 && told.2 == key.2);
+        if self.told_version == Some(key) || told_this_gesture {
             return None;
         }
         let want_folds = !key.1;
@@ -466,6 +471,15 @@ mod tests {
             })
             .collect();
         assert_eq!(count(&session.handle_texts(&moves)), (1, 1, 0, 1));
+        // Later moves of the gesture: a frame, no state (the page moves the points itself);
+        // its end: the state.
+        let later = r#"{"type":"edit","gesture":3,"op":{"op":"move_points","layer":0,"points":[0],"dx":20,"dy":5}}"#;
+        assert_eq!(
+            count(&session.handle_texts(&[later.to_string()])),
+            (1, 0, 0, 1)
+        );
+        let end = r#"{"type":"end_gesture"}"#.to_string();
+        assert_eq!(count(&session.handle_texts(&[end])).1, 1);
         let editor = session.app.editor();
         assert_eq!(
             editor.history.current().doc.layers[0].points[0].position.x,

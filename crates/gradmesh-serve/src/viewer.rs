@@ -5,7 +5,7 @@ use gradmesh::render::{self, RenderCache, RenderOptions, View};
 use gradmesh::Document;
 
 /// The first bytes of every frame message.
-pub const FRAME_MAGIC: &[u8; 4] = b"GMF1";
+pub const FRAME_MAGIC: &[u8; 4] = b"GMF2";
 
 /// The largest canvas side the editor renders, in pixels.
 pub const MAX_CANVAS_SIDE: u32 = 8192;
@@ -105,7 +105,12 @@ impl Viewer {
         let runs = if self.shown.len() == len {
             changed_runs(&self.shown, &self.drawn, row)
         } else {
-            vec![(0, vp.height as usize)]
+            vec![Run {
+                first: 0,
+                count: vp.height as usize,
+                x: 0,
+                width: vp.width as usize,
+            }]
         };
         std::mem::swap(&mut self.shown, &mut self.drawn);
         if runs.is_empty() {
@@ -132,42 +137,77 @@ impl Viewer {
     }
 }
 
-/// Runs of rows `(first, count)` where `new` differs from `old` (images of rows of `row` bytes).
-/// Runs closer than 8 rows are merged: a run's header costs more than a few rows re-sent.
-pub fn changed_runs(old: &[u8], new: &[u8], row: usize) -> Vec<(usize, usize)> {
-    let mut runs: Vec<(usize, usize)> = Vec::new();
+/// A rectangle of changed pixels: rows `first..first + count`, columns `x..x + width`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Run {
+    /// The first row.
+    pub first: usize,
+    /// How many rows.
+    pub count: usize,
+    /// The first column.
+    pub x: usize,
+    /// How many columns.
+    pub width: usize,
+}
+
+/// The columns `x0..x1` where two rows of RGBA8 pixels differ, if they do.
+fn changed_columns(a: &[u8], b: &[u8]) -> Option<(usize, usize)> {
+    let differ = |(p, q): (&[u8], &[u8])| p != q;
+    let pixels = || a.chunks_exact(4).zip(b.chunks_exact(4));
+    let x0 = pixels().position(differ)?;
+    let x1 = a.len() / 4 - pixels().rev().position(differ).expect("a pixel differs");
+    Some((x0, x1))
+}
+
+/// Rectangles covering the pixels where `new` differs from `old` (images of rows of `row`
+/// bytes), in row order. Rows closer than 8 are merged into one rectangle spanning the columns
+/// of both: a rectangle's header and the page's call to draw it cost more than a few pixels
+/// sent again.
+pub fn changed_runs(old: &[u8], new: &[u8], row: usize) -> Vec<Run> {
+    let mut runs: Vec<Run> = Vec::new();
     for (y, (a, b)) in old.chunks_exact(row).zip(new.chunks_exact(row)).enumerate() {
-        if a == b {
+        let Some((x0, x1)) = changed_columns(a, b) else {
             continue;
-        }
+        };
         match runs.last_mut() {
-            Some((first, count)) if y - (*first + *count) < 8 => *count = y + 1 - *first,
-            _ => runs.push((y, 1)),
+            Some(r) if y - (r.first + r.count) < 8 => {
+                let (left, right) = (r.x.min(x0), (r.x + r.width).max(x1));
+                *r = Run {
+                    count: y + 1 - r.first,
+                    x: left,
+                    width: right - left,
+                    ..*r
+                };
+            }
+            _ => runs.push(Run {
+                first: y,
+                count: 1,
+                x: x0,
+                width: x1 - x0,
+            }),
         }
     }
     runs
 }
 
 /// A frame message: [`FRAME_MAGIC`], then little-endian `u32`s: frame number, width, height,
-/// number of runs; then each run: first row, row count, and its RGBA8 rows.
-pub fn encode_frame(
-    number: u32,
-    width: u32,
-    height: u32,
-    runs: &[(usize, usize)],
-    pixels: &[u8],
-) -> Vec<u8> {
+/// number of runs; then each run: first row, row count, first column, column count, and the
+/// RGBA8 pixels of its rectangle, row by row.
+pub fn encode_frame(number: u32, width: u32, height: u32, runs: &[Run], pixels: &[u8]) -> Vec<u8> {
     let row = 4 * width as usize;
-    let rows: usize = runs.iter().map(|r| r.1).sum();
-    let mut out = Vec::with_capacity(20 + 8 * runs.len() + rows * row);
+    let area: usize = runs.iter().map(|r| r.count * r.width).sum();
+    let mut out = Vec::with_capacity(20 + 16 * runs.len() + 4 * area);
     out.extend_from_slice(FRAME_MAGIC);
     for v in [number, width, height, runs.len() as u32] {
         out.extend_from_slice(&v.to_le_bytes());
     }
-    for &(first, count) in runs {
-        out.extend_from_slice(&(first as u32).to_le_bytes());
-        out.extend_from_slice(&(count as u32).to_le_bytes());
-        out.extend_from_slice(&pixels[first * row..(first + count) * row]);
+    for r in runs {
+        for v in [r.first, r.count, r.x, r.width] {
+            out.extend_from_slice(&(v as u32).to_le_bytes());
+        }
+        for y in r.first..r.first + r.count {
+            out.extend_from_slice(&pixels[y * row + 4 * r.x..y * row + 4 * (r.x + r.width)]);
+        }
     }
     out
 }
@@ -175,33 +215,34 @@ pub fn encode_frame(
 /// Applies a frame message to `image` (RGBA8 of the frame's size, resized if it is not):
 /// the inverse of [`encode_frame`], as the page does it. Returns the frame number.
 pub fn decode_frame(message: &[u8], image: &mut Vec<u8>) -> Result<u32, String> {
-    let word = |i: usize| -> Result<u32, String> {
+    let word = |i: usize| -> Result<usize, String> {
         let bytes = message
             .get(i..i + 4)
             .ok_or("the frame message is cut short")?;
-        Ok(u32::from_le_bytes(bytes.try_into().expect("four bytes")))
+        Ok(u32::from_le_bytes(bytes.try_into().expect("four bytes")) as usize)
     };
     if message.get(..4) != Some(FRAME_MAGIC) {
         return Err("not a frame message".into());
     }
     let (number, width, height, runs) = (word(4)?, word(8)?, word(12)?, word(16)?);
-    let row = 4 * width as usize;
-    image.resize(row * height as usize, 0);
+    let row = 4 * width;
+    image.resize(row * height, 0);
     let mut at = 20;
     for _ in 0..runs {
-        let (first, count) = (word(at)? as usize, word(at + 4)? as usize);
-        at += 8;
-        let bytes = count * row;
-        let src = message
-            .get(at..at + bytes)
-            .ok_or("the frame message is cut short")?;
-        image
-            .get_mut(first * row..first * row + bytes)
-            .ok_or("a run lies outside the image")?
-            .copy_from_slice(src);
-        at += bytes;
+        let (first, count, x, columns) = (word(at)?, word(at + 4)?, word(at + 8)?, word(at + 12)?);
+        at += 16;
+        if x + columns > width || first + count > height {
+            return Err("a run lies outside the image".into());
+        }
+        for y in first..first + count {
+            let src = message
+                .get(at..at + 4 * columns)
+                .ok_or("the frame message is cut short")?;
+            image[y * row + 4 * x..y * row + 4 * (x + columns)].copy_from_slice(src);
+            at += 4 * columns;
+        }
     }
-    Ok(number)
+    Ok(number as u32)
 }
 
 #[cfg(test)]
@@ -209,29 +250,50 @@ mod tests {
     use super::*;
 
     #[test]
-    fn runs_cover_the_changed_rows() {
-        let row = 8;
+    fn runs_cover_the_changed_pixels() {
+        let row = 4 * 10;
         let old = vec![0u8; row * 40];
         let mut new = old.clone();
-        for y in [3, 5, 30] {
-            new[y * row + 2] = 9;
+        for (y, x) in [(3, 2), (5, 7), (30, 4)] {
+            new[y * row + 4 * x + 1] = 9;
         }
-        assert_eq!(changed_runs(&old, &new, row), vec![(3, 3), (30, 1)]);
+        let run = |first, count, x, width| Run {
+            first,
+            count,
+            x,
+            width,
+        };
+        assert_eq!(
+            changed_runs(&old, &new, row),
+            vec![run(3, 3, 2, 6), run(30, 1, 4, 1)]
+        );
         assert!(changed_runs(&old, &old, row).is_empty());
     }
 
     #[test]
     fn frames_round_trip() {
-        let (w, h) = (3u32, 20u32);
+        let (w, h) = (6u32, 20u32);
         let pixels: Vec<u8> = (0..4 * w * h).map(|i| (i * 7 % 251) as u8).collect();
         let mut image = vec![0u8; pixels.len()];
-        let runs = [(0usize, 2usize), (10, 10)];
+        let runs = changed_runs(&image, &pixels, 4 * w as usize);
         let message = encode_frame(5, w, h, &runs, &pixels);
         assert_eq!(decode_frame(&message, &mut image), Ok(5));
+        assert_eq!(image, pixels);
+
+        // Two rectangles: only their pixels are sent and set.
+        let mut changed = pixels.clone();
         let row = 4 * w as usize;
-        assert_eq!(image[..2 * row], pixels[..2 * row]);
-        assert_eq!(image[10 * row..], pixels[10 * row..]);
-        assert!(image[2 * row..10 * row].iter().all(|&b| b == 0));
+        changed[row + 4..row + 8].copy_from_slice(&[1, 2, 3, 4]);
+        changed[15 * row + 20..15 * row + 24].copy_from_slice(&[5, 6, 7, 8]);
+        let runs = changed_runs(&pixels, &changed, row);
+        assert_eq!(runs.len(), 2);
+        let message = encode_frame(6, w, h, &runs, &changed);
+        assert_eq!(message.len(), 20 + 2 * 16 + 2 * 4);
+        assert_eq!(decode_frame(&message, &mut image), Ok(6));
+        assert_eq!(image, changed);
         assert!(decode_frame(&message[..30], &mut image).is_err());
+        let mut outside = message.clone();
+        outside[28..32].copy_from_slice(&6u32.to_le_bytes());
+        assert!(decode_frame(&outside, &mut image).is_err());
     }
 }
