@@ -28,6 +28,7 @@ mod fuzz_replay;
 mod limit_matrix;
 mod opensubdiv_oracle;
 mod options;
+mod pdf_other_programs;
 mod pdf_read;
 mod properties;
 mod reference_images;

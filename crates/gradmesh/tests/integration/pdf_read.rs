@@ -26,14 +26,14 @@ const ERODE_PX: i64 = 3;
 
 /// ΔE00 figures over the mesh pixels.
 #[derive(Debug, Clone, Copy)]
-struct Figures {
-    mean: f64,
-    p99: f64,
-    pixels: usize,
+pub(crate) struct Figures {
+    pub mean: f64,
+    pub p99: f64,
+    pub pixels: usize,
 }
 
 /// The picture of `picture` drawn by gradmesh at `width` x `height` (on white when `white`).
-fn render_pdf(picture: &pdf::PdfPicture, width: u32, height: u32, white: bool) -> Image {
+pub(crate) fn render_pdf(picture: &pdf::PdfPicture, width: u32, height: u32, white: bool) -> Image {
     let (doc, _) = pdf::picture_to_document(picture, ColourSpace::Lab);
     let layers = pdf_picture_layers(&picture.fills, &doc.layers, SvgMeshRendering::Classic);
     let mut opts = RenderOptions::new(width, height, View::from_rect(picture.view_rect()));
@@ -47,7 +47,7 @@ fn render_pdf(picture: &pdf::PdfPicture, width: u32, height: u32, white: bool) -
 }
 
 /// Mesh pixels: covered fully by `alpha` in a window of [`ERODE_PX`] around.
-fn mesh_pixels(alpha: &Image) -> Vec<bool> {
+pub(crate) fn mesh_pixels(alpha: &Image) -> Vec<bool> {
     let (w, h) = (alpha.width as i64, alpha.height as i64);
     let a = |x: i64, y: i64| alpha.data[4 * (y * w + x) as usize + 3];
     (0..h)
@@ -63,7 +63,7 @@ fn mesh_pixels(alpha: &Image) -> Vec<bool> {
         .collect()
 }
 
-fn figures(ours: &Raster, theirs: &Raster, inside: &[bool], name: &str) -> Figures {
+pub(crate) fn figures(ours: &Raster, theirs: &Raster, inside: &[bool], name: &str) -> Figures {
     assert_eq!(
         (ours.width, ours.height),
         (theirs.width, theirs.height),
@@ -87,14 +87,14 @@ fn figures(ours: &Raster, theirs: &Raster, inside: &[bool], name: &str) -> Figur
     }
 }
 
-fn scratch(name: &str) -> PathBuf {
+pub(crate) fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("gradmesh-pdfin-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
 
 /// Keeps a picture when `GRADMESH_KEEP_EXPORTS` is set.
-fn keep(image: &Image, path: &Path) {
+pub(crate) fn keep(image: &Image, path: &Path) {
     if std::env::var_os("GRADMESH_KEEP_EXPORTS").is_some() {
         let mut png = Vec::new();
         gradmesh::render::write_png(
@@ -174,7 +174,7 @@ const SVG_FILES: [&str; 13] = [
 ];
 
 /// `inkscape SVG --export-type=pdf` into `dir`; the PDF's path.
-fn inkscape_pdf(name: &str, dir: &Path) -> PathBuf {
+pub(crate) fn inkscape_pdf(name: &str, dir: &Path) -> PathBuf {
     let svg = realdata::meshgradient(name);
     let stem = Path::new(name)
         .file_stem()
@@ -201,7 +201,7 @@ fn inkscape_pdf(name: &str, dir: &Path) -> PathBuf {
 /// The pixels where poppler shows a shading of the PDF at `path`: those that change when every
 /// shading's colours are inverted (`Decode` ranges of three components `0 1` swapped, in a
 /// copy of the file of the same length), a pixel in from their edge.
-fn visible_in_poppler(path: &Path, plain: &Raster) -> Vec<bool> {
+pub(crate) fn visible_in_poppler(path: &Path, plain: &Raster) -> Vec<bool> {
     let bytes = std::fs::read(path).unwrap();
     let (from, to) = (b"0 1 0 1 0 1 ]".as_slice(), b"1 0 1 0 1 0 ]".as_slice());
     let mut inverted = bytes.clone();
