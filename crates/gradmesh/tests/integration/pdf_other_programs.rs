@@ -231,3 +231,53 @@ fn other_programs_pdfs_match_pdftoppm() {
     }
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// A file of the PDF test data (`tests/data/pdf`), failing the test when it is missing.
+fn test_data(name: &str) -> PathBuf {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/pdf")
+        .join(name);
+    assert!(
+        path.exists(),
+        "the test data file {} is missing",
+        path.display()
+    );
+    path
+}
+
+/// Two files of pdf.js's test corpus written by Ghostscript 9.14 (`tests/data/pdf/README.md`):
+/// every edge flag, colour through a function, one Coons and one tensor-product shading. Read,
+/// converted into valid layers of the scheme, and rendered within the bar of pdftoppm (the
+/// page holds nothing else, so every pixel gradmesh covers is a mesh pixel).
+#[test]
+fn pdfjs_all_flags_files_match_pdftoppm() {
+    let dir = scratch("pdfjs");
+    for (name, shading_type) in [
+        ("coons-allflags-withfunction.pdf", 6),
+        ("tensor-allflags-withfunction.pdf", 7),
+    ] {
+        let source = test_data(name);
+        let path = dir.join(name);
+        std::fs::copy(&source, &path).unwrap();
+        let read = pdf::read_path_with_limits(&path, 1, &Limits::DEFAULT)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        for mesh in &read.document.layers {
+            gradmesh::validate(mesh).unwrap_or_else(|e| panic!("{name}: {e}"));
+        }
+        let case = Case {
+            name: name.into(),
+            path,
+            types: vec![shading_type],
+            visible: None,
+        };
+        let (f, spread) = compare(&case);
+        eprintln!(
+            "{name}: {} patches, {} pixels; against pdftoppm mean {:.2}, 99th {:.2}; mutool against pdftoppm mean {:.2}, 99th {:.2}",
+            read.picture.fills[0].patches.len(), f.pixels, f.mean, f.p99, spread.mean, spread.p99
+        );
+        assert!(f.mean <= 1.0 && f.p99 <= 4.0, "{name}: {f:?}");
+    }
+    if std::env::var_os("GRADMESH_KEEP_EXPORTS").is_none() {
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
