@@ -146,19 +146,20 @@ fn bradford(xyz: [f64; 3], from: [f64; 3], to: [f64; 3]) -> [f64; 3] {
     mul(&B_INV, scaled)
 }
 
-/// A PDF function: of one input (types 0, 2 and 3, or an array of them of one output each),
-/// or a PostScript calculator program of any number of inputs (type 4).
+/// A PDF function: of one input (types 2 and 3), of any number of inputs (types 0 and 4), or
+/// an array of functions of one output each.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Function {
-    /// Type 0: samples over the domain, interpolated linearly.
+    /// Type 0: samples over a grid of the domain, interpolated multilinearly.
     Sampled {
-        /// `Domain`.
-        domain: [f64; 2],
-        /// `Encode` of the input, into `0..size - 1`.
-        encode: [f64; 2],
-        /// The number of samples.
-        size: usize,
-        /// The outputs, `size` rows of the output count, already decoded.
+        /// `Domain`: a range per input.
+        domain: Vec<[f64; 2]>,
+        /// `Encode`: each input's range mapped to `0..size - 1`.
+        encode: Vec<[f64; 2]>,
+        /// `Size`: the number of samples along each input.
+        size: Vec<usize>,
+        /// The outputs at each point of the grid, the first input varying fastest, already
+        /// decoded.
         samples: Vec<f64>,
         /// The number of outputs.
         outputs: usize,
@@ -213,6 +214,30 @@ impl Function {
             Function::PostScript { range, .. } => self
                 .try_eval(inputs)
                 .unwrap_or_else(|_| range.iter().map(|&r| clip(0.0, r)).collect()),
+            Function::Sampled {
+                domain,
+                encode,
+                size,
+                samples,
+                outputs,
+            } => {
+                let grid = SampleGrid {
+                    size,
+                    samples,
+                    outputs: *outputs,
+                };
+                let at: Vec<f64> = (domain.iter().zip(encode).enumerate())
+                    .map(|(k, (&d, &e))| {
+                        let x = clip(inputs.get(k).copied().unwrap_or(0.0), d);
+                        interpolate(x, d, e).clamp(0.0, (size[k] - 1) as f64)
+                    })
+                    .collect();
+                grid.at(&at)
+            }
+            Function::Array(functions) => functions
+                .iter()
+                .flat_map(|f| f.eval_inputs(inputs).into_iter().take(1))
+                .collect(),
             _ => self.eval(inputs.first().copied().unwrap_or(0.0)),
         }
     }
@@ -241,30 +266,8 @@ impl Function {
 
     /// The outputs at `x` (clipped to the domain), for a function of one input.
     pub fn eval(&self, x: f64) -> Vec<f64> {
-        let interpolate = |x: f64, from: [f64; 2], to: [f64; 2]| {
-            if from[1] == from[0] {
-                to[0]
-            } else {
-                to[0] + (x - from[0]) * (to[1] - to[0]) / (from[1] - from[0])
-            }
-        };
         match self {
-            Function::Sampled {
-                domain,
-                encode,
-                size,
-                samples,
-                outputs,
-            } => {
-                let e = interpolate(clip(x, *domain), *domain, *encode);
-                let e = e.clamp(0.0, (*size - 1) as f64);
-                let i0 = (e.floor() as usize).min(size - 1);
-                let i1 = (i0 + 1).min(size - 1);
-                let t = e - i0 as f64;
-                (0..*outputs)
-                    .map(|k| samples[i0 * outputs + k] * (1.0 - t) + samples[i1 * outputs + k] * t)
-                    .collect()
-            }
+            Function::Sampled { .. } | Function::PostScript { .. } => self.eval_inputs(&[x]),
             Function::Exponential { domain, c0, c1, n } => {
                 let x = clip(x, *domain);
                 let p = if *n == 1.0 { x } else { x.max(0.0).powf(*n) };
@@ -291,8 +294,61 @@ impl Function {
                 .iter()
                 .flat_map(|f| f.eval(x).into_iter().take(1))
                 .collect(),
-            Function::PostScript { .. } => self.eval_inputs(&[x]),
         }
+    }
+}
+
+/// `x` mapped from the range `from` to the range `to` (to `to[0]` when `from` is empty).
+fn interpolate(x: f64, from: [f64; 2], to: [f64; 2]) -> f64 {
+    if from[1] == from[0] {
+        to[0]
+    } else {
+        to[0] + (x - from[0]) * (to[1] - to[0]) / (from[1] - from[0])
+    }
+}
+
+/// The samples of a type 0 function on their grid.
+struct SampleGrid<'a> {
+    size: &'a [usize],
+    samples: &'a [f64],
+    outputs: usize,
+}
+
+impl SampleGrid<'_> {
+    /// The outputs at the grid position `at` (an index from 0 to `size - 1` along each
+    /// input), multilinear between the samples around it: the sum over the corners of the
+    /// cell of each corner's outputs times the product of its weights along each input.
+    fn at(&self, at: &[f64]) -> Vec<f64> {
+        // Along each input: the lower sample, the step to the upper one, and the weight of the upper.
+        let mut stride = 1;
+        let mut base = 0;
+        let mut varying: Vec<(usize, f64)> = Vec::new();
+        for (k, &e) in at.iter().enumerate() {
+            let lower = (e.floor() as usize).min(self.size[k] - 1);
+            let t = e - lower as f64;
+            base += lower * stride;
+            if t > 0.0 && lower + 1 < self.size[k] {
+                varying.push((stride, t));
+            }
+            stride *= self.size[k];
+        }
+        let mut out = vec![0.0; self.outputs];
+        for corner in 0u32..(1 << varying.len()) {
+            let (mut index, mut weight) = (base, 1.0);
+            for (bit, &(step, t)) in varying.iter().enumerate() {
+                if (corner >> bit) & 1 == 1 {
+                    index += step;
+                    weight *= t;
+                } else {
+                    weight *= 1.0 - t;
+                }
+            }
+            let row = &self.samples[index * self.outputs..(index + 1) * self.outputs];
+            for (o, s) in out.iter_mut().zip(row) {
+                *o += weight * s;
+            }
+        }
+        out
     }
 }
 

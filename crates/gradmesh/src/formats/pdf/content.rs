@@ -9,9 +9,10 @@ use kurbo::{Affine, BezPath, ParamCurve, Point, Rect, Shape};
 use lopdf::content::Content;
 use lopdf::{Dictionary, Object, ObjectId};
 
+use super::colour::ShadingColour;
 use super::objects::{invalid, number, object_name, Objects};
-use super::scene::{ClipPath, ShadingFill};
-use super::shading::{read_shading, Shading, ShadingLimits};
+use super::scene::{ClipPath, Patch, ShadingFill};
+use super::shading::{read_shading, ReadShading, Shading, ShadingLimits};
 use crate::error::Error;
 use crate::formats::svg::FillRule;
 
@@ -293,14 +294,16 @@ impl<'a> Interpreter<'a> {
     }
 
     /// Paints the shading `object` with `to_picture` (its space to picture units), clipped by
-    /// the state's clip and `extra`.
+    /// the state's clip and `pattern_path`, the path filled when the shading is a pattern's;
+    /// then, its `Background` first, as poppler, MuPDF and Ghostscript paint it (`sh` ignores
+    /// the `Background`, as the specification says).
     fn paint_shading(
         &mut self,
         object: &'a Object,
         what: &str,
         state: &State,
         to_picture: Affine,
-        extra: Option<ClipPath>,
+        pattern_path: Option<ClipPath>,
     ) -> Result<(), Error> {
         let read = match read_shading(self.objects, object, what, self.limits)? {
             Shading::Mesh(read) => read,
@@ -309,30 +312,19 @@ impl<'a> Interpreter<'a> {
                 return Ok(());
             }
         };
-        self.patches += read.patches.len() as u64;
-        if self.patches > self.limits.patches {
-            return Err(crate::error::ErrorKind::LimitExceeded {
-                what: "the patches of the page".into(),
-                found: self.patches,
-                limit: self.limits.patches,
-            }
-            .into());
+        let mut clips = state.clips.clone();
+        let bbox = read.bbox.map(|b| to_picture * b.to_path(0.1));
+        clips.extend(bbox.clone().map(|b| (b, FillRule::NonZero)));
+        if let Some(path) = &pattern_path {
+            clips.push(path.clone());
+            self.paint_background(&read, what, state, clips.clone(), &path.0, bbox.as_ref())?;
         }
-        if read.background {
-            self.note(format!("{what}: the Background is not painted"));
-        }
-        let mask = state.soft_mask.clone();
         let mut patches = read.patches;
         for patch in &mut patches {
             for p in patch.points.iter_mut().flatten() {
                 *p = to_picture * *p;
             }
         }
-        let mut clips = state.clips.clone();
-        if let Some(b) = read.bbox {
-            clips.push((to_picture * b.to_path(0.1), FillRule::NonZero));
-        }
-        clips.extend(extra);
         let mut fill = ShadingFill {
             object: what.to_string(),
             shading_type: read.shading_type,
@@ -342,8 +334,7 @@ impl<'a> Interpreter<'a> {
             opacity: state.fill_alpha.clamp(0.0, 1.0),
             corner_opacity: None,
         };
-        let bounds = fill.control_bounds();
-        match mask {
+        match state.soft_mask.clone() {
             Some(SoftMask::Shading(mask)) => match mask_opacity(&mask, &fill) {
                 Some(opacity) => fill.corner_opacity = Some(opacity),
                 None => self.note(format!(
@@ -356,6 +347,74 @@ impl<'a> Interpreter<'a> {
             }
             None => {}
         }
+        self.push_fill(fill, clips, what)
+    }
+
+    /// Paints the `Background` of the shading `read` of a pattern fill, if it has one: its
+    /// colour over the filled `path` (in picture units) within the shading's `bbox`, under
+    /// the same clips as the shading.
+    fn paint_background(
+        &mut self,
+        read: &ReadShading,
+        what: &str,
+        state: &State,
+        clips: Vec<ClipPath>,
+        path: &BezPath,
+        bbox: Option<&BezPath>,
+    ) -> Result<(), Error> {
+        let components = match &read.background {
+            None => return Ok(()),
+            Some(Err(why)) => {
+                self.note(format!("{why}: the Background is not painted"));
+                return Ok(());
+            }
+            Some(Ok(components)) => components,
+        };
+        let mut area = path.bounding_box();
+        if let Some(b) = bbox {
+            area = area.intersect(b.bounding_box());
+        }
+        if area.width() <= 0.0 || area.height() <= 0.0 {
+            return Ok(());
+        }
+        if state.soft_mask.is_some() {
+            self.note(format!(
+                "{what}: the soft mask is not applied to the Background"
+            ));
+        }
+        let fill = ShadingFill {
+            object: format!("{what} /Background"),
+            shading_type: 6,
+            patches: vec![Patch::flat(area, components)],
+            colour: ShadingColour {
+                space: read.colour.space.clone(),
+                function: None,
+            },
+            clip: None,
+            opacity: state.fill_alpha.clamp(0.0, 1.0),
+            corner_opacity: None,
+        };
+        self.push_fill(fill, clips, what)
+    }
+
+    /// Adds `fill` to the picture, within the page's patch limit, clipped by the innermost
+    /// of `clips` that does not hold all of it (a warning says when more than one was left).
+    fn push_fill(
+        &mut self,
+        mut fill: ShadingFill,
+        mut clips: Vec<ClipPath>,
+        what: &str,
+    ) -> Result<(), Error> {
+        self.patches += fill.patches.len() as u64;
+        if self.patches > self.limits.patches {
+            return Err(crate::error::ErrorKind::LimitExceeded {
+                what: "the patches of the page".into(),
+                found: self.patches,
+                limit: self.limits.patches,
+            }
+            .into());
+        }
+        let bounds = fill.control_bounds();
         clips.retain(|(path, _)| !rectangle_holding(path, bounds));
         if clips.len() > 1 {
             self.note(format!(

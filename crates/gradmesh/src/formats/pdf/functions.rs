@@ -12,11 +12,14 @@ use crate::error::Error;
 const MAX_FUNCTION_DEPTH: usize = 8;
 /// The most samples of a sampled function.
 const MAX_SAMPLES: u64 = 1 << 20;
+/// The most inputs of a sampled function (each evaluation interpolates between up to
+/// `2^inputs` samples).
+const MAX_SAMPLED_INPUTS: usize = 8;
 /// The most bytes of a type 4 function's program.
 const MAX_PROGRAM_BYTES: u64 = 1 << 20;
 
-/// Reads a function of `inputs` inputs: of type 0, 2 or 3 (one input), an array of them, or
-/// of type 4 (any number of inputs, up to 32).
+/// Reads a function of `inputs` inputs: of type 2 or 3 (one input by definition), of type 0
+/// (up to [`MAX_SAMPLED_INPUTS`] inputs) or 4 (up to 32), or an array of them.
 pub(crate) fn read_function(
     objects: Objects,
     object: &Object,
@@ -69,15 +72,21 @@ fn read_function_at(
     if kind == 4.0 {
         return read_postscript(objects, resolved, what, &domain);
     }
-    if inputs != 1 {
+    if kind == 0.0 {
+        return read_sampled(objects, resolved, what, &pairs(&domain));
+    }
+    if inputs != 1 && (kind == 2.0 || kind == 3.0) {
         return Err(invalid(
             what,
-            format!("a function of {inputs} inputs of FunctionType {kind} is not read (type 4 is)"),
+            format!(
+                "a function of FunctionType {kind} has one input by definition (PDF 32000-1, \
+                 7.10.3 and 7.10.4), but {inputs} inputs are needed here: {inputs} colourants \
+                 need a function of type 0 or 4"
+            ),
         ));
     }
     let domain = [domain[0], domain[1]];
     match kind {
-        0.0 => read_sampled(objects, resolved, what, domain),
         2.0 => read_exponential(objects, dict, what, domain),
         3.0 => read_stitching(objects, dict, what, domain, depth),
         other => Err(invalid(
@@ -187,7 +196,6 @@ fn read_postscript(
     let source = objects.stream_data(stream, what, MAX_PROGRAM_BYTES)?;
     let program = Program::parse(&source)
         .map_err(|e| invalid(what, format!("its PostScript program cannot be read: {e}")))?;
-    let pairs = |v: &[f64]| v.chunks(2).map(|p| [p[0], p[1]]).collect::<Vec<_>>();
     let function = Function::PostScript {
         domain: pairs(domain),
         range: pairs(&range),
@@ -204,6 +212,11 @@ fn read_postscript(
     Ok(function)
 }
 
+/// The numbers `v` in pairs.
+fn pairs(v: &[f64]) -> Vec<[f64; 2]> {
+    v.chunks_exact(2).map(|p| [p[0], p[1]]).collect()
+}
+
 /// The inputs a type 4 function is tried at when read: the centre of its domain and its
 /// corners (the first 64 of them).
 fn trial_inputs(domain: &[[f64; 2]]) -> Vec<Vec<f64>> {
@@ -218,32 +231,24 @@ fn trial_inputs(domain: &[[f64; 2]]) -> Vec<Vec<f64>> {
     std::iter::once(centre).chain(corners).collect()
 }
 
-/// Reads a sampled function (type 0) of one input.
+/// Reads a sampled function (type 0) over `domain` (a range per input).
 fn read_sampled(
     objects: Objects,
     object: &Object,
     what: &str,
-    domain: [f64; 2],
+    domain: &[[f64; 2]],
 ) -> Result<Function, Error> {
     let stream = objects.stream(object, what)?;
     let dict = &stream.dict;
-    let numbers = |key: &[u8]| -> Result<Option<Vec<f64>>, Error> {
-        objects
-            .get(dict, key, what)?
-            .map(|o| objects.numbers(o, what))
-            .transpose()
-    };
+    let numbers = |key: &[u8]| read_numbers(objects, dict, key, what);
+    let inputs = domain.len();
     let size = numbers(b"Size")?.ok_or_else(|| invalid(what, "the function has no Size"))?;
+    let size = sample_counts(&size, inputs, what)?;
     let range = numbers(b"Range")?.ok_or_else(|| invalid(what, "the function has no Range"))?;
-    let bits = numbers(b"BitsPerSample")?
-        .and_then(|b| b.first().copied())
+    let bits = objects
+        .get(dict, b"BitsPerSample", what)?
         .ok_or_else(|| invalid(what, "the function has no BitsPerSample"))?;
-    if size.len() != 1 || !(1.0..=MAX_SAMPLES as f64).contains(&size[0]) {
-        return Err(invalid(
-            what,
-            format!("Size must be one count from 1 to {MAX_SAMPLES}"),
-        ));
-    }
+    let bits = objects.number(bits, &format!("{what} /BitsPerSample"))?;
     if ![1.0, 2.0, 4.0, 8.0, 12.0, 16.0, 24.0, 32.0].contains(&bits) {
         return Err(invalid(
             what,
@@ -253,27 +258,94 @@ fn read_sampled(
     if range.len() < 2 || range.len() % 2 != 0 {
         return Err(invalid(what, "Range must be pairs of numbers"));
     }
-    let (size, bits, outputs) = (size[0] as usize, bits as u32, range.len() / 2);
-    let encode = numbers(b"Encode")?.unwrap_or_else(|| vec![0.0, (size - 1) as f64]);
+    let default_encode: Vec<f64> = size.iter().flat_map(|&s| [0.0, (s - 1) as f64]).collect();
+    let encode = numbers(b"Encode")?.unwrap_or(default_encode);
     let decode = numbers(b"Decode")?.unwrap_or_else(|| range.clone());
-    if encode.len() != 2 || decode.len() != range.len() {
-        return Err(invalid(what, "Encode or Decode has the wrong length"));
+    if encode.len() != 2 * inputs || decode.len() != range.len() {
+        return Err(invalid(
+            what,
+            format!(
+                "Encode must have {} numbers (2 an input) and Decode {} (2 an output)",
+                2 * inputs,
+                range.len()
+            ),
+        ));
     }
     let data = objects.stream_data(stream, what, MAX_SAMPLES * 8)?;
-    let needed = (size * outputs) as u64 * u64::from(bits);
+    let samples = decode_samples(
+        &data,
+        size.iter().product(),
+        bits as u32,
+        &range,
+        &decode,
+        what,
+    )?;
+    Ok(Function::Sampled {
+        domain: domain.to_vec(),
+        encode: pairs(&encode),
+        size,
+        samples,
+        outputs: range.len() / 2,
+    })
+}
+
+/// The `Size` of a sampled function of `inputs` inputs: a count from 1 up an input, at most
+/// [`MAX_SAMPLES`] in all.
+fn sample_counts(size: &[f64], inputs: usize, what: &str) -> Result<Vec<usize>, Error> {
+    if inputs > MAX_SAMPLED_INPUTS {
+        return Err(invalid(
+            what,
+            format!(
+                "a sampled function of {inputs} inputs is not read (at most {MAX_SAMPLED_INPUTS})"
+            ),
+        ));
+    }
+    let counts_ok = size.len() == inputs
+        && size.iter().all(|s| s.fract() == 0.0 && *s >= 1.0)
+        && size
+            .iter()
+            .try_fold(1.0f64, |all, s| {
+                let all = all * s;
+                (all <= MAX_SAMPLES as f64).then_some(all)
+            })
+            .is_some();
+    if !counts_ok {
+        return Err(invalid(
+            what,
+            format!(
+                "Size must be {inputs} whole count{} of at least 1, of at most {MAX_SAMPLES} samples in all",
+                if inputs == 1 { "" } else { "s" }
+            ),
+        ));
+    }
+    Ok(size.iter().map(|&s| s as usize).collect())
+}
+
+/// The `count` samples of `data`, `range.len() / 2` outputs each of `bits` bits, decoded by
+/// `decode` and clipped to `range`.
+fn decode_samples(
+    data: &[u8],
+    count: usize,
+    bits: u32,
+    range: &[f64],
+    decode: &[f64],
+    what: &str,
+) -> Result<Vec<f64>, Error> {
+    let outputs = range.len() / 2;
+    let needed = (count as u64) * (outputs as u64) * u64::from(bits);
     if (data.len() as u64) * 8 < needed {
         return Err(invalid(
             what,
             format!(
-                "the stream holds {} bytes, fewer than its {size} samples need",
+                "the stream holds {} bytes, fewer than its {count} samples need",
                 data.len()
             ),
         ));
     }
-    let mut reader = BitReader::new(&data);
+    let mut reader = BitReader::new(data);
     let max = ((1u64 << bits) - 1) as f64;
-    let mut samples = Vec::with_capacity(size * outputs);
-    for _ in 0..size {
+    let mut samples = Vec::with_capacity(count * outputs);
+    for _ in 0..count {
         for k in 0..outputs {
             let raw = reader.read(bits).unwrap_or(0) as f64;
             let value = decode[2 * k] + raw * (decode[2 * k + 1] - decode[2 * k]) / max;
@@ -283,11 +355,5 @@ fn read_sampled(
             ));
         }
     }
-    Ok(Function::Sampled {
-        domain,
-        encode: [encode[0], encode[1]],
-        size,
-        samples,
-        outputs,
-    })
+    Ok(samples)
 }

@@ -116,6 +116,23 @@ pub struct Patch {
 }
 
 impl Patch {
+    /// A flat patch over `rect` whose four corners have the components `components`.
+    pub fn flat(rect: Rect, components: &[f64]) -> Patch {
+        let mut points = [[Point::ZERO; 4]; 4];
+        for (i, row) in points.iter_mut().enumerate() {
+            for (j, point) in row.iter_mut().enumerate() {
+                *point = Point::new(
+                    rect.x0 + rect.width() * i as f64 / 3.0,
+                    rect.y0 + rect.height() * j as f64 / 3.0,
+                );
+            }
+        }
+        Patch {
+            points,
+            components: components.repeat(4),
+        }
+    }
+
     /// The surface at `(u, v)`.
     pub fn eval(&self, u: f64, v: f64) -> Point {
         let bu = bernstein(u);

@@ -19,8 +19,9 @@ pub(crate) struct ReadShading {
     pub colour: ShadingColour,
     /// `BBox`, in the shading's coordinates.
     pub bbox: Option<Rect>,
-    /// Whether the shading has a `Background` (painted by gradmesh for no use).
-    pub background: bool,
+    /// The `Background`'s components in the shading's colour space, or why they cannot be
+    /// used; `None` without one.
+    pub background: Option<Result<Vec<f64>, String>>,
 }
 
 /// What a shading object is.
@@ -75,7 +76,15 @@ pub(crate) fn read_shading(
         }
         None => None,
     };
-    let background = objects.get(dict, b"Background", what)?.is_some();
+    let background = match objects.get(dict, b"Background", what)? {
+        Some(b) => Some(background_components(
+            objects,
+            b,
+            &colour,
+            &format!("{what} /Background"),
+        )?),
+        None => None,
+    };
     let layout = RecordLayout::read(objects, dict, &colour, shading_type, what)?;
     let stream = objects.stream(object, what)?;
     let data = objects.stream_data(stream, what, limits.bytes)?;
@@ -87,6 +96,27 @@ pub(crate) fn read_shading(
         bbox,
         background,
     }))
+}
+
+/// The components of the `Background` array `object`: as many as the colour space has (a
+/// `Function` does not apply to them); of another number, the reason it is not used, as
+/// poppler leaves such a background out.
+fn background_components(
+    objects: Objects,
+    object: &Object,
+    colour: &ShadingColour,
+    what: &str,
+) -> Result<Result<Vec<f64>, String>, Error> {
+    let components = objects.numbers(object, what)?;
+    let expected = colour.space.components();
+    Ok(if components.len() == expected {
+        Ok(components)
+    } else {
+        Err(format!(
+            "{what} has {} numbers where its colour space has {expected} components",
+            components.len()
+        ))
+    })
 }
 
 /// The layout of a shading's patch records.

@@ -408,7 +408,34 @@ fn bad_tint_transforms_are_errors_naming_the_object() {
     let exponential = b"<< /FunctionType 2 /Domain [0 1 0 1] /C1 [1 1 1] /N 1 >>".to_vec();
     let e = read_one(&dict, [0; 4], vec![exponential]).unwrap_err();
     assert!(
-        e.contains("of 2 inputs of FunctionType 2 is not read"),
+        e.contains("FunctionType 2 has one input by definition")
+            && e.contains("2 colourants need a function of type 0 or 4"),
+        "{e}"
+    );
+    let stitching = b"<< /FunctionType 3 /Domain [0 1 0 1] /Functions [] >>".to_vec();
+    let e = read_one(&dict, [0; 4], vec![stitching]).unwrap_err();
+    assert!(
+        e.contains("FunctionType 3 has one input by definition"),
+        "{e}"
+    );
+    // A sampled tint transform of more inputs than are interpolated.
+    let names = "/A /B /C /D /E /F /G /H /I";
+    let sampled = stream(
+        &format!(
+            "/FunctionType 0 /Domain [{}] /Range [0 1] /Size [{}] /BitsPerSample 8",
+            "0 1 ".repeat(9),
+            "1 ".repeat(9)
+        ),
+        &[0],
+    );
+    let e = read_one(
+        &device_n_shading(names, "/DeviceGray"),
+        [0; 4],
+        vec![sampled],
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("a sampled function of 9 inputs is not read (at most 8)"),
         "{e}"
     );
 }
@@ -513,4 +540,166 @@ fn rotate_turns_the_picture_clockwise() {
         .warnings
         .iter()
         .any(|w| w.contains("/Rotate 45 is not a multiple of 90")));
+}
+
+/// A shading dictionary of the DeviceN space `[/DeviceN [names] alternate 7 0 R]` with one
+/// 8-bit component a colourant decoded to 0..1, over [`coons_record`]'s patch.
+fn device_n_shading(names: &str, alternate: &str) -> String {
+    let count = names.split_whitespace().count();
+    format!(
+        "/ShadingType 6 /ColorSpace [/DeviceN [{names}] {alternate} 7 0 R] \
+         /BitsPerCoordinate 8 /BitsPerComponent 8 /BitsPerFlag 8 /Decode [0 255 0 255 {}]",
+        "0 1 ".repeat(count)
+    )
+}
+
+/// The tint transform of `fill`, a `Tinted` space, at `tints`, in sRGB.
+fn tinted_srgb(fill: &ShadingFill, tints: &[f64]) -> [f64; 3] {
+    fill.colour.space.to_srgb(tints)
+}
+
+#[test]
+fn a_device_n_space_through_a_sampled_tint_transform_of_two_inputs() {
+    // Size [2 2], the first input varying fastest: (0, 0) black, (1, 0) red, (0, 1) blue,
+    // (1, 1) white.
+    let samples = [0, 0, 0, 255, 0, 0, 0, 0, 255, 255, 255, 255];
+    let tint = stream(
+        "/FunctionType 0 /Domain [0 1 0 1] /Range [0 1 0 1 0 1] /Size [2 2] /BitsPerSample 8",
+        &samples,
+    );
+    let dict = device_n_shading("/A /B", "/DeviceRGB");
+    let mut record = coons_record()[..25].to_vec();
+    // c00 (0, 0), c03 (1, 0), c33 (1, 1), c30 (0, 1).
+    record.extend([0, 0, 255, 0, 255, 255, 0, 255]);
+    let file = page_with("/S0 sh", stream(&dict, &record), vec![tint]);
+    let picture = read_pdf(&file, 1, &Limits::DEFAULT).unwrap();
+    let fill = &picture.fills[0];
+    let at = |u, v| fill.srgb_at(&fill.patches[0], u, v);
+    assert_near(at(0.0, 0.0), [0.0, 0.0, 0.0]);
+    assert_near(at(0.0, 1.0), [1.0, 0.0, 0.0]);
+    assert_near(at(1.0, 1.0), [1.0, 1.0, 1.0]);
+    // Tints (0.5, 0): half way from black to red.
+    assert_near(at(0.0, 0.5), [0.5, 0.0, 0.0]);
+    // Tints (0.5, 0.5): the mean of the four samples.
+    assert_near(at(0.5, 0.5), [0.5, 0.25, 0.5]);
+    // Tints (0.5, 1): half way from blue to white.
+    assert_near(at(1.0, 0.5), [0.5, 0.5, 1.0]);
+}
+
+#[test]
+fn a_sampled_tint_transform_steps_through_an_uneven_grid() {
+    // Size [3 2] into grey: (i, j) = (0, 0) 0, (1, 0) 1, (2, 0) 0, (0, 1) 0.2, (1, 1) 0.4,
+    // (2, 1) 1.
+    let mut record = coons_record()[..25].to_vec();
+    record.extend([0; 8]);
+    let tint = stream(
+        "/FunctionType 0 /Domain [0 1 0 1] /Range [0 1] /Size [3 2] /BitsPerSample 8",
+        &[0, 255, 0, 51, 102, 255],
+    );
+    let dict = device_n_shading("/A /B", "/DeviceGray");
+    let file = page_with("/S0 sh", stream(&dict, &record), vec![tint]);
+    let picture = read_pdf(&file, 1, &Limits::DEFAULT).unwrap();
+    let fill = &picture.fills[0];
+    let grey = |g: f64| [g, g, g];
+    assert_near(tinted_srgb(fill, &[0.5, 0.0]), grey(1.0));
+    assert_near(tinted_srgb(fill, &[1.0, 1.0]), grey(1.0));
+    assert_near(tinted_srgb(fill, &[0.5, 1.0]), grey(0.4));
+    // a = 0.75 is half way between the samples 1 and 2; b = 0.5 half way between rows: the
+    // mean of 1, 0, 0.4 and 1.
+    assert_near(tinted_srgb(fill, &[0.75, 0.5]), grey(0.6));
+    // b = 0.25 along a = 0: 0.25 of the way from 0 to 0.2.
+    assert_near(tinted_srgb(fill, &[0.0, 0.25]), grey(0.05));
+}
+
+#[test]
+fn an_array_of_type_4_functions_of_two_inputs_gives_an_output_each() {
+    // (a, b) -> RGB ((a + b) / 2, a, b).
+    let functions = [
+        postscript_function(2, 1, "{ add 2 div }"),
+        postscript_function(2, 1, "{ pop }"),
+        postscript_function(2, 1, "{ exch pop }"),
+    ];
+    let mut objects = vec![b"[8 0 R 9 0 R 10 0 R]".to_vec()];
+    objects.extend(functions);
+    let mut record = coons_record()[..25].to_vec();
+    record.extend([0; 8]);
+    let dict = device_n_shading("/A /B", "/DeviceRGB");
+    let file = page_with("/S0 sh", stream(&dict, &record), objects);
+    let picture = read_pdf(&file, 1, &Limits::DEFAULT).unwrap();
+    assert_near(tinted_srgb(&picture.fills[0], &[0.2, 0.6]), [0.4, 0.2, 0.6]);
+}
+
+#[test]
+fn the_background_fills_a_pattern_fill_and_is_ignored_by_sh() {
+    let with_background = |extra: &str| {
+        let dict = format!("{SHADING_DICT} /Background [1 0 0] {extra}");
+        stream(&dict, &coons_record())
+    };
+    let fill_page = "/Pattern cs /P0 scn 0 0 300 200 re f";
+    let picture = read_pdf(
+        &page_with(fill_page, with_background(""), vec![]),
+        1,
+        &Limits::DEFAULT,
+    )
+    .unwrap();
+    assert_eq!(picture.fills.len(), 2);
+    let background = &picture.fills[0];
+    assert_eq!(background.object, "object 5 /Background");
+    assert_eq!(
+        background.control_bounds(),
+        Rect::new(0.0, 0.0, 300.0, 200.0)
+    );
+    assert_near(
+        background.srgb_at(&background.patches[0], 0.5, 0.5),
+        [1.0, 0.0, 0.0],
+    );
+    assert_eq!(picture.fills[1].object, "object 5");
+    // Within the BBox, [0 0 100 100] in pattern space, moved by the pattern's Matrix to
+    // (10, 20)-(110, 120) on the page, y down in the picture of 200 points.
+    let picture = read_pdf(
+        &page_with(fill_page, with_background("/BBox [0 0 100 100]"), vec![]),
+        1,
+        &Limits::DEFAULT,
+    )
+    .unwrap();
+    let bounds = picture.fills[0].control_bounds();
+    assert!(
+        (bounds.x0 - 10.0).abs() < 1e-9 && (bounds.x1 - 110.0).abs() < 1e-9,
+        "{bounds:?}"
+    );
+    assert!(
+        (bounds.y0 - 80.0).abs() < 1e-9 && (bounds.y1 - 180.0).abs() < 1e-9,
+        "{bounds:?}"
+    );
+    // sh paints the shading alone.
+    let picture = read_pdf(
+        &page_with("/S0 sh", with_background(""), vec![]),
+        1,
+        &Limits::DEFAULT,
+    )
+    .unwrap();
+    assert_eq!(picture.fills.len(), 1);
+    // A Background of the wrong length is left out, with a warning naming it.
+    let picture = read_pdf(
+        &page_with(
+            fill_page,
+            stream(
+                &format!("{SHADING_DICT} /Background [1 0]"),
+                &coons_record(),
+            ),
+            vec![],
+        ),
+        1,
+        &Limits::DEFAULT,
+    )
+    .unwrap();
+    assert_eq!(picture.fills.len(), 1);
+    assert!(
+        picture
+            .warnings
+            .iter()
+            .any(|w| w.contains("object 5 /Background has 2 numbers")),
+        "{:?}",
+        picture.warnings
+    );
 }
