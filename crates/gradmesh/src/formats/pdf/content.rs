@@ -435,6 +435,21 @@ impl<'a> Interpreter<'a> {
         Ok(())
     }
 
+    /// Notes a blend mode (`BM`, a name or an array whose first name is used) other than
+    /// `Normal` and `Compatible`: shadings are composited as `Normal`.
+    fn note_blend_mode(&mut self, mode: &Object, label: &str) {
+        let name = match mode {
+            Object::Array(items) => items.first().and_then(|o| o.as_name().ok()),
+            other => other.as_name().ok(),
+        };
+        if let Some(name) = name.filter(|n| *n != b"Normal" && *n != b"Compatible") {
+            self.note(format!(
+                "{label}: the blend mode {} is not applied (shadings are composited as Normal)",
+                String::from_utf8_lossy(name)
+            ));
+        }
+    }
+
     /// `gs`: the fill opacity and the soft mask.
     fn graphics_state(
         &mut self,
@@ -452,6 +467,9 @@ impl<'a> Interpreter<'a> {
         let dict = self.objects.dict(object, &label)?;
         if let Some(ca) = self.objects.get(dict, b"ca", &label)? {
             state.fill_alpha = self.objects.number(ca, &format!("{label} /ca"))?;
+        }
+        if let Some(mode) = self.objects.get(dict, b"BM", &label)? {
+            self.note_blend_mode(mode, &label);
         }
         if let Some(mask) = self.objects.get(dict, b"SMask", &label)? {
             state.soft_mask = match mask {

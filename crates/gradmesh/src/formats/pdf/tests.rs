@@ -703,3 +703,35 @@ fn the_background_fills_a_pattern_fill_and_is_ignored_by_sh() {
         picture.warnings
     );
 }
+
+#[test]
+fn a_blend_mode_other_than_normal_is_named_in_a_warning() {
+    let page = |mode: &str| {
+        let objects = vec![
+            b"<< /Type /Catalog /Pages 2 0 R >>".to_vec(),
+            b"<< /Type /Pages /Kids [3 0 R] /Count 1 >>".to_vec(),
+            b"<< /Type /Page /Parent 2 0 R /MediaBox [0 0 300 200] /Contents 4 0 R /Resources << /Shading << /S0 5 0 R >> /ExtGState << /G0 6 0 R >> >> >>".to_vec(),
+            stream("", b"/G0 gs /S0 sh"),
+            stream(SHADING_DICT, &coons_record()),
+            format!("<< /Type /ExtGState /BM {mode} >>").into_bytes(),
+        ];
+        read_pdf(&pdf_file(&objects, ""), 1, &Limits::DEFAULT).unwrap()
+    };
+    let screen = page("/Screen");
+    assert!(
+        screen
+            .warnings
+            .iter()
+            .any(|w| w.contains("object 6: the blend mode Screen is not applied")),
+        "{:?}",
+        screen.warnings
+    );
+    assert!(page("[/Multiply /Normal]")
+        .warnings
+        .iter()
+        .any(|w| w.contains("Multiply")));
+    assert!(page("/Normal")
+        .warnings
+        .iter()
+        .all(|w| !w.contains("blend mode")));
+}
