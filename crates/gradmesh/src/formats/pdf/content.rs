@@ -306,7 +306,7 @@ impl<'a> Interpreter<'a> {
         pattern_path: Option<ClipPath>,
     ) -> Result<(), Error> {
         let read = match read_shading(self.objects, object, what, self.limits)? {
-            Shading::Mesh(read) => read,
+            Shading::Mesh(read) => *read,
             Shading::Other(kind) => {
                 self.note(format!("shadings of type {kind} are not drawn ({what})"));
                 return Ok(());

@@ -27,7 +27,7 @@ pub(crate) struct ReadShading {
 /// What a shading object is.
 pub(crate) enum Shading {
     /// A patch mesh (type 6 or 7), read.
-    Mesh(ReadShading),
+    Mesh(Box<ReadShading>),
     /// Another type, not read.
     Other(i64),
 }
@@ -89,13 +89,13 @@ pub(crate) fn read_shading(
     let stream = objects.stream(object, what)?;
     let data = objects.stream_data(stream, what, limits.bytes)?;
     let patches = decode_patches(&data, &layout, limits.patches, what)?;
-    Ok(Shading::Mesh(ReadShading {
+    Ok(Shading::Mesh(Box::new(ReadShading {
         shading_type,
         patches,
         colour,
         bbox,
         background,
-    }))
+    })))
 }
 
 /// The components of the `Background` array `object`: as many as the colour space has (a
