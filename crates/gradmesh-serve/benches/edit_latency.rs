@@ -109,15 +109,19 @@ struct Target {
 }
 
 /// The point whose change of colour redraws the most pixels, and the point whose move (by 2
-/// pixels, as a drag step) takes the longest to render, each through a `RenderCache` as the
-/// editor renders (the quicker of two tries, against interference).
+/// pixels, as a drag step, drawn as a draft) takes the longest to render, each through a
+/// `RenderCache` as the editor renders (the quicker of two tries, against interference).
 fn costliest_points(doc: &Document, opts: &RenderOptions) -> (Target, Target) {
     let mut cache = RenderCache::new();
     let mut pixels = vec![0u8; 4 * opts.width as usize * opts.height as usize];
-    let mut render = |d: &Document, cache: &mut RenderCache| {
+    let draft = RenderOptions {
+        draft: true,
+        ..opts.clone()
+    };
+    let mut render = |d: &Document, opts: &RenderOptions, cache: &mut RenderCache| {
         render::render_document_into_cached(d, opts, cache, &mut pixels).expect("renders")
     };
-    render(doc, &mut cache);
+    render(doc, opts, &mut cache);
     let pixel = opts.view.width() / opts.width as f64;
     let mut colour = (
         0,
@@ -144,9 +148,9 @@ fn costliest_points(doc: &Document, opts: &RenderOptions) -> (Target, Target) {
                 pixel,
             };
             edited.layers[layer].points[point].colour[0] += 30.0;
-            let info = render(&edited, &mut cache);
+            let info = render(&edited, opts, &mut cache);
             edited.layers[layer].points[point].colour[0] -= 30.0;
-            render(&edited, &mut cache);
+            render(&edited, opts, &mut cache);
             if info.drawn_pixels > colour.0 {
                 colour = (info.drawn_pixels, target);
             }
@@ -154,10 +158,10 @@ fn costliest_points(doc: &Document, opts: &RenderOptions) -> (Target, Target) {
             for _ in 0..2 {
                 edited.layers[layer].points[point].position.x += 2.0 * pixel;
                 let start = Instant::now();
-                render(&edited, &mut cache);
+                render(&edited, &draft, &mut cache);
                 quickest = quickest.min(start.elapsed());
                 edited.layers[layer].points[point].position.x -= 2.0 * pixel;
-                render(&edited, &mut cache);
+                render(&edited, opts, &mut cache);
             }
             if quickest > drag.0 {
                 drag = (quickest, target);
