@@ -275,7 +275,7 @@ impl RunConverter {
 
     /// Converts the first `n` colours of `c` (channel `k` of colour `m` at `c[k][m]`) into
     /// `out[m]`.
-    // Always inlined: see `render::wide_vectors`.
+    // Always inlined: see `render::composite::wide_vectors`.
     #[inline(always)]
     pub fn convert(&self, c: &[[f32; RUN]; 3], n: usize, out: &mut [[f32; 3]; RUN]) {
         let n = n.min(RUN);

@@ -6,8 +6,8 @@
 //! there with the phantom point `2 C - P`, which reproduces the subdivision rules that keep the
 //! corner fixed and put edge points at midpoints). Its limit points are the crease and corner
 //! limit stencils, so the curve runs exactly through the limit positions of the boundary.
-//! The renderer flattens these segments for coverage (`render::outline`); the export writes them
-//! as Bézier curves.
+//! The renderer flattens these segments for coverage (`render::tessellate::outline`); the export
+//! writes them as Bézier curves.
 
 use std::collections::HashMap;
 

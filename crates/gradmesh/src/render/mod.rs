@@ -22,9 +22,10 @@
 //!      count where the surface folds), each edge takes the finer count of its faces, both
 //!      sides use bit-identical samples along it, and the coarser side fans its boundary cells
 //!      out to them. Cells are drawn in the order and with the diagonals of the quads uniform
-//!      refinement would make (see `adaptive.rs`, `face_plans.rs` and `stitch.rs`).
+//!      refinement would make (see `tessellate/adaptive.rs`, `plan/face_plans.rs` and
+//!      `tessellate/stitch.rs`).
 //!      A face whose cells fail with linear colour is also measured with *quadratic* colour
-//!      (six-node triangles, see `quadratic.rs`; [`RenderOptions::quadratic`]) against the
+//!      (six-node triangles, see `plan/quadratic.rs`; [`RenderOptions::quadratic`]) against the
 //!      surface at the triangles' quarter points, and keeps whichever passes first: where
 //!      colour is smooth, quadratic pieces converge as the cube of the cell size and need far
 //!      fewer cells; near extraordinary vertices and folds the faces stay linear.
