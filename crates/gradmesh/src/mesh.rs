@@ -139,7 +139,7 @@ pub struct GradientMesh {
     pub edges: BTreeMap<(u32, u32), EdgeTag>,
     /// Per-side colours and handles at discontinuous edges.
     pub wedges: Vec<WedgeOverride>,
-    /// Multi-resolution edits of refined vertices (see [`VertexAddress`](crate::VertexAddress)), at most one per vertex.
+    /// Multi-resolution edits of refined vertices (see [`VertexAddress`]), at most one per vertex.
     pub edits: Vec<Edit>,
     /// Which edits the mesh allows below level 0.
     pub fine_edits: FineEdits,

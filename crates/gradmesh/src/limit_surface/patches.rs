@@ -158,8 +158,8 @@ pub(crate) fn regular_patch(level: &Level, data: &[VertexData], f: usize) -> Opt
     regular_patch_with(level, data, f, |v| regular_corner(level, v))
 }
 
-/// Whether each vertex of `level` is a [`regular_patch`] corner: computed once for a level,
-/// rather than four times (once per face around it) by [`regular_patch`].
+/// Whether each vertex of `level` is a `regular_patch` corner: computed once for a level,
+/// rather than four times (once per face around it) by `regular_patch`.
 pub(crate) fn regular_corners(level: &Level) -> Vec<bool> {
     (0..level.topology.vertex_count())
         .into_par_iter()
@@ -167,7 +167,7 @@ pub(crate) fn regular_corners(level: &Level) -> Vec<bool> {
         .collect()
 }
 
-/// [`regular_patch`] with the corners' regularity given (see [`regular_corners`]).
+/// `regular_patch` with the corners' regularity given (see [`regular_corners`]).
 pub(crate) fn regular_patch_with(
     level: &Level,
     data: &[VertexData],
@@ -178,7 +178,7 @@ pub(crate) fn regular_patch_with(
         .map(|points| control_grid(&points, |v| data[v as usize]))
 }
 
-/// The vertices of `level` at the places of a [`regular_patch`]'s control grid (`None` for the
+/// The vertices of `level` at the places of a `regular_patch`'s control grid (`None` for the
 /// phantoms beyond a boundary), if face `f`'s limit surface is one: which it is, and where
 /// its points are, depends on the topology alone.
 fn regular_patch_points(

@@ -60,14 +60,14 @@ pub struct RenderCache {
 /// An image [`render_document_into_cached`](super::render_document_into_cached) drew, and the options it drew it with.
 pub(super) struct LastImage {
     pub(super) opts: RenderOptions,
-    /// A `Vec<P>` of the [`OutputPixel`] type it was drawn in.
+    /// A `Vec<P>` of the [`OutputPixel`](super::OutputPixel) type it was drawn in.
     pub(super) pixels: Box<dyn std::any::Any + Send + Sync>,
     /// Per band, then per layer: the farthest an outline pixel's colour was taken from (the
     /// nearest boundary point, see [`nearest`](super::tessellate::nearest)); negative infinity where none was.
     pub(super) reach: Vec<f64>,
 }
 
-/// The most shapes of local refinement a [`RenderCache`](super::RenderCache) keeps: a few hundred kilobytes each
+/// The most shapes of local refinement a [`RenderCache`] keeps: a few hundred kilobytes each
 /// at most, and a layer has a few dozen.
 pub(super) const MAX_CACHED_SHAPES: usize = 1024;
 

@@ -114,7 +114,7 @@ pub(crate) struct Band<'a, P> {
 }
 
 /// Draws every layer into a band. Inlined into the two compilations of
-/// [`draw_band_dispatched`], with the hot functions it calls: each step below is
+/// [`draw_band_dispatched`](crate::render::draw_band_dispatched), with the hot functions it calls: each step below is
 /// `#[inline(always)]` so that it is compiled for the wide vectors too.
 #[inline(always)]
 pub(crate) fn draw_band<P: OutputPixel>(job: Band<'_, P>, s: &mut Scratch) {

@@ -283,7 +283,7 @@ impl Triangle {
         Self::new_quadratic(v, exact, attr, None, &UNBOUNDED)
     }
 
-    /// As [`Triangle::new`], and with `mids` quadratic: `mids[k]` are the attributes at the
+    /// As `Triangle::new` (the tests' constructor), and with `mids` quadratic: `mids[k]` are the attributes at the
     /// midpoint of the exact side from vertex `k` to vertex `k + 1` (the six nodes of a
     /// quadratic Lagrange triangle). Two triangles that share a side and its three nodes agree
     /// all along it.

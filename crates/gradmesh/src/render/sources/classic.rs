@@ -5,7 +5,7 @@
 //! Coons interior points is the same surface). Its colour is bilinear in the patch's
 //! parameters, in sRGB-encoded values, and so is its opacity (stop-opacity times
 //! fill-opacity and the group opacity). With `type="bicubic"` the colours are smoothed across
-//! patches as Inkscape does (see [`bicubic_lattices`]): the colour of each patch becomes
+//! patches as Inkscape does (see `formats::svg::paint`'s `bicubic_lattices`): the colour of each patch becomes
 //! bilinear over an 8 x 8 lattice of Hermite-interpolated values.
 //!
 //! Tessellation: every patch is cut into a grid of cells in its parameters, each cell into two

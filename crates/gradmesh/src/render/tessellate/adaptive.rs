@@ -131,7 +131,7 @@ pub(crate) struct TessellationCache {
     /// The data of the base level the plans were made from.
     data: Vec<VertexData>,
     faces: Vec<CachedPlan>,
-    /// Whether each face's plan was made by a draft ([`RenderOptions::draft`](super::RenderOptions::draft)).
+    /// Whether each face's plan was made by a draft ([`RenderOptions::draft`](crate::render::RenderOptions::draft)).
     drafted: Vec<bool>,
     /// What the plans drew (empty until the triangles of the plans above are built).
     triangles: Option<TriangleBlocks>,

@@ -143,7 +143,8 @@ impl NearestSegments {
         self.attributes_and_distance_at(p).map(|(a, _)| a)
     }
 
-    /// [`NearestSegments::attributes_at`], and the distance to that point.
+    /// The attributes at the point of the boundary nearest to `p`, and the distance to that
+    /// point; `None` without boundary.
     pub fn attributes_and_distance_at(&self, p: [f64; 2]) -> Option<([f32; 4], f64)> {
         if self.segments.is_empty() {
             return None;
