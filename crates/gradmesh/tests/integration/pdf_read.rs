@@ -243,7 +243,7 @@ pub(crate) fn visible_in_poppler(path: &Path, plain: &Raster) -> Vec<bool> {
 }
 
 /// Inkscape's PDF export of the 13 SVG test files (Cairo writes their meshes as type 7
-/// shadings), rendered by gradmesh and by `pdftoppm` at 72 dpi, over the mesh pixels (covered
+/// shadings), rendered by gradmesh and by `pdftoppm` at 96 dpi (a CSS pixel a pixel), over the mesh pixels (covered
 /// by gradmesh and showing a shading in poppler's page: other content painted over a mesh is
 /// left out): mean at most 1 ΔE00 and 99th percentile at most 4, or no farther from poppler
 /// than MuPDF (`mutool draw`) is on both. Two of the files export to PDF as nothing; then
