@@ -1,5 +1,5 @@
 //! The `render` fuzz target: arbitrary meshes drawn with arbitrary options, then drawn again
-//! through a [`RenderCache`] after an arbitrary edit.
+//! through a [`RenderCache`] after an arbitrary edit, first as a draft, then exactly.
 //!
 //! It panics when the renderer misbehaves: a panic inside it, a pixel left unwritten, a channel
 //! that is not finite or outside `0..=1`, a cached render that differs from a fresh one, a
@@ -393,7 +393,30 @@ fn render_both<P: Channel>(
     }
 }
 
-/// Draws the described document, edits it, and draws it again through the same cache.
+/// Draws `doc` through `cache` as a draft ([`RenderOptions::draft`], as the editor draws a
+/// gesture): a render that gives every channel a value in range, or an error with a message.
+fn draft_through<P: Channel>(
+    doc: &Document,
+    opts: &RenderOptions,
+    cache: &mut RenderCache,
+    outline: bool,
+) {
+    let draft = RenderOptions {
+        draft: true,
+        ..opts.clone()
+    };
+    match draw::<P>(doc, &draft, Some(cache), outline) {
+        Ok(pixels) => {
+            for (i, x) in pixels.iter().enumerate() {
+                assert!(x.in_range(), "the draft: channel {i} is {x:?}");
+            }
+        }
+        Err(e) => check_error(&e),
+    }
+}
+
+/// Draws the described document, edits it, draws the edit as a draft and then exactly through
+/// the same cache (which must equal a render from scratch: the drafted faces are planned again).
 pub fn render_entry(desc: &RenderDescription) {
     let doc = desc.document();
     let opts = desc.options(&doc);
@@ -409,7 +432,12 @@ pub fn render_entry(desc: &RenderDescription) {
     }
     let mut edited = doc.clone();
     desc.edit.apply(&mut edited);
-    run(&edited, &mut cache, "after the edit");
+    match desc.bits {
+        Bits::Eight => draft_through::<u8>(&edited, &opts, &mut cache, outline),
+        Bits::Sixteen => draft_through::<u16>(&edited, &opts, &mut cache, outline),
+        Bits::Float => draft_through::<f32>(&edited, &opts, &mut cache, outline),
+    }
+    run(&edited, &mut cache, "after the edit and its draft");
 }
 
 /// Decodes `data` as the render target does (arbitrary's `arbitrary_take_rest`) and runs it.
