@@ -62,8 +62,9 @@ pub struct RenderOptions {
     /// colour and outline tolerances, twice the largest quad), for an editor while a gesture is
     /// open. Through a [`RenderCache`](super::RenderCache) only the faces an edit reaches are
     /// planned, so the rest of the picture keeps its exact plans, and the next render without
-    /// `draft` plans the drafted faces again at the full tolerances: the picture after the
-    /// gesture is the one a render from scratch gives. Without a cache every face is drafted.
+    /// `draft` plans the drafted faces again at the full tolerances and builds the drafted
+    /// layers' triangles again: the picture after the gesture is the one a render from scratch
+    /// gives. Without a cache every face is drafted.
     /// Only the fast path drafts (the uniform path and [`reference`](Self::reference) ignore it).
     pub draft: bool,
 }

@@ -306,7 +306,9 @@ pub(crate) fn tessellate(
     // is taken out (it fits these plans only where they were kept).
     let mut last_triangles = None;
     if let Some(cache) = cache.as_deref_mut() {
-        last_triangles = cache.triangles.take().filter(|_| again.is_some());
+        // After a draft, every face builds its triangles again.
+        let after_draft = !th.draft && cache.has_drafts();
+        last_triangles = (cache.triangles.take()).filter(|_| again.is_some() && !after_draft);
         cache.keep_plans(&faces, topology_id, k0, th.space, d, th.draft);
     }
 
