@@ -425,6 +425,16 @@ mod tests {
     use crate::ops::Picture;
     use gradmesh::render::RenderOptions;
 
+    /// A session of `picture`, not yet saved, in the temporary folder.
+    fn session_of(picture: Picture) -> Session {
+        let editor = Editor {
+            history: History::new(picture),
+            path: None,
+        };
+        let app = App::new(editor, Folder::new(&std::env::temp_dir()).unwrap());
+        Session::new(Arc::new(app))
+    }
+
     fn square_session() -> Session {
         let mut picture = Picture::default();
         Op::AddLayer { name: None }.apply(&mut picture).unwrap();
@@ -434,12 +444,7 @@ mod tests {
         }
         .apply(&mut picture)
         .unwrap();
-        let editor = Editor {
-            history: History::new(picture),
-            path: None,
-        };
-        let app = App::new(editor, Folder::new(&std::env::temp_dir()).unwrap());
-        Session::new(Arc::new(app))
+        session_of(picture)
     }
 
     fn count(out: &[Outgoing]) -> (usize, usize, usize, usize) {
@@ -517,12 +522,7 @@ mod tests {
         }
         .apply(&mut picture)
         .unwrap();
-        let editor = Editor {
-            history: History::new(picture),
-            path: None,
-        };
-        let app = App::new(editor, Folder::new(&std::env::temp_dir()).unwrap());
-        Session::new(Arc::new(app))
+        session_of(picture)
     }
 
     /// The session's document rendered from scratch as its viewer renders it, exactly.
