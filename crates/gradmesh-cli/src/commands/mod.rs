@@ -72,6 +72,7 @@ enum ClassicFill {
     /// An SVG mesh-gradient fill.
     Svg(gradmesh::formats::svg::MeshFill),
     /// A PDF patch-mesh shading.
+    #[cfg_attr(not(feature = "pdf-read"), allow(dead_code))]
     Pdf(gradmesh::formats::pdf::ShadingFill),
 }
 
@@ -87,25 +88,9 @@ struct Input {
 
 /// [`read`], with the file's [`Viewport`] and fills when it has them.
 fn read_with_viewport(path: &Path, limits: &gradmesh::Limits, page: usize) -> Result<Input, Error> {
-    use gradmesh::formats::{pdf, svg, Format};
+    use gradmesh::formats::{svg, Format};
     if gradmesh::formats::is_pdf_path(path) {
-        let read = pdf::read_path_with_limits(path, page, limits)?;
-        let view = read.picture.view_rect();
-        return Ok(Input {
-            document: read.document,
-            viewport: Some((
-                gradmesh::render::View::from_rect(view),
-                (view.width(), view.height()),
-            )),
-            fills: Some(
-                read.picture
-                    .fills
-                    .into_iter()
-                    .map(ClassicFill::Pdf)
-                    .collect(),
-            ),
-            warnings: read.warnings,
-        });
+        return read_pdf(path, limits, page);
     }
     if Format::from_path(path) == Some(Format::Svg) {
         let read = svg::read_path_with_limits(path, limits)?;
@@ -122,6 +107,41 @@ fn read_with_viewport(path: &Path, limits: &gradmesh::Limits, page: usize) -> Re
     }
     Ok(Input {
         document: gradmesh::formats::read_path_with_limits(path, limits)?,
+        viewport: None,
+        fills: None,
+        warnings: Vec::new(),
+    })
+}
+
+/// Page `page` of a PDF (or `.ai`) file, with its page as the viewport and its shadings as the
+/// fills.
+#[cfg(feature = "pdf-read")]
+fn read_pdf(path: &Path, limits: &gradmesh::Limits, page: usize) -> Result<Input, Error> {
+    let read = gradmesh::formats::pdf::read_path_with_limits(path, page, limits)?;
+    let view = read.picture.view_rect();
+    Ok(Input {
+        document: read.document,
+        viewport: Some((
+            gradmesh::render::View::from_rect(view),
+            (view.width(), view.height()),
+        )),
+        fills: Some(
+            read.picture
+                .fills
+                .into_iter()
+                .map(ClassicFill::Pdf)
+                .collect(),
+        ),
+        warnings: read.warnings,
+    })
+}
+
+/// Without the `pdf-read` feature a PDF file is refused, as the library refuses it.
+#[cfg(not(feature = "pdf-read"))]
+fn read_pdf(path: &Path, limits: &gradmesh::Limits, _page: usize) -> Result<Input, Error> {
+    let document = gradmesh::formats::read_path_with_limits(path, limits)?;
+    Ok(Input {
+        document,
         viewport: None,
         fills: None,
         warnings: Vec::new(),

@@ -106,7 +106,7 @@ pub fn read_path_with_limits(path: &Path, limits: &Limits) -> Result<Document, E
 
 fn read_path_unlocated(path: &Path, limits: &Limits) -> Result<Document, Error> {
     if is_pdf_path(path) {
-        return pdf::read_path_with_limits(path, 1, limits).map(|read| read.document);
+        return read_pdf_document(path, limits);
     }
     let format = Format::from_path(path).ok_or_else(|| {
         let found = match path.extension() {
@@ -127,6 +127,19 @@ fn read_path_unlocated(path: &Path, limits: &Limits) -> Result<Document, Error> 
         }
     }
     Ok(doc)
+}
+
+#[cfg(feature = "pdf-read")]
+fn read_pdf_document(path: &Path, limits: &Limits) -> Result<Document, Error> {
+    pdf::read_path_with_limits(path, 1, limits).map(|read| read.document)
+}
+
+/// Without the `pdf-read` feature a PDF file is refused, naming the feature.
+#[cfg(not(feature = "pdf-read"))]
+fn read_pdf_document(_path: &Path, _limits: &Limits) -> Result<Document, Error> {
+    Err(Error::new(ErrorKind::UnsupportedFormat(
+        "reading PDF and Illustrator files needs gradmesh built with its feature pdf-read".into(),
+    )))
 }
 
 /// Whether `path` names a PDF file by its extension: `.pdf`, or `.ai` (Illustrator files

@@ -8,7 +8,7 @@ use super::bits::BitReader;
 use super::colour::ShadingColour;
 use super::functions::read_function;
 use super::objects::{invalid, Objects};
-use super::scene::{coons_interior, Patch};
+use super::scene::{coons_interior, Patch, POINT_ORDER};
 use super::spaces::read_colour_space;
 use crate::error::{Error, ErrorKind};
 
@@ -190,27 +190,6 @@ impl RecordLayout {
             + (corners * self.components) as u64 * u64::from(self.component_bits)
     }
 }
-
-/// The stream positions of the points of a type 7 record with flag 0: `(i, j)` of `p[i][j]`,
-/// `i` along `u` (the writer's order too).
-pub(crate) const POINT_ORDER: [(usize, usize); 16] = [
-    (0, 0),
-    (0, 1),
-    (0, 2),
-    (0, 3),
-    (1, 3),
-    (2, 3),
-    (3, 3),
-    (3, 2),
-    (3, 1),
-    (3, 0),
-    (2, 0),
-    (1, 0),
-    (1, 1),
-    (1, 2),
-    (2, 2),
-    (2, 1),
-];
 
 /// Corner colours in stream order (c00, c03, c33, c30) as indices of [`Patch::components`]
 /// corners ((0, 0), (0, 1), (1, 0), (1, 1)).

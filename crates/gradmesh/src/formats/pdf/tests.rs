@@ -1,8 +1,10 @@
 //! PDF files written by hand: what is read from them, and clear errors on hostile ones.
 
-use kurbo::Point;
+use kurbo::{Point, Rect};
 
 use super::*;
+use crate::colour::ColourSpace;
+use crate::size_limits::Limits;
 
 /// A PDF file of the given objects (numbered from 1; object 1 is the catalog), with a correct
 /// cross-reference table, and `trailer_extra` added to the trailer.
