@@ -211,6 +211,27 @@ pub(crate) fn coons_interior(p: &mut [[Point; 4]; 4]) {
 #[cfg(feature = "pdf-read")]
 pub(crate) type ClipPath = (BezPath, FillRule);
 
+/// The stream positions of the points of a type 7 record with flag 0: `(i, j)` of `p[i][j]`,
+/// `i` along `u` (the writer's order too).
+pub(crate) const POINT_ORDER: [(usize, usize); 16] = [
+    (0, 0),
+    (0, 1),
+    (0, 2),
+    (0, 3),
+    (1, 3),
+    (2, 3),
+    (3, 3),
+    (3, 2),
+    (3, 1),
+    (3, 0),
+    (2, 0),
+    (1, 0),
+    (1, 1),
+    (1, 2),
+    (2, 2),
+    (2, 1),
+];
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -265,24 +286,3 @@ mod tests {
         }
     }
 }
-
-/// The stream positions of the points of a type 7 record with flag 0: `(i, j)` of `p[i][j]`,
-/// `i` along `u` (the writer's order too).
-pub(crate) const POINT_ORDER: [(usize, usize); 16] = [
-    (0, 0),
-    (0, 1),
-    (0, 2),
-    (0, 3),
-    (1, 3),
-    (2, 3),
-    (3, 3),
-    (3, 2),
-    (3, 1),
-    (3, 0),
-    (2, 0),
-    (1, 0),
-    (1, 1),
-    (1, 2),
-    (2, 2),
-    (2, 1),
-];
