@@ -3,14 +3,18 @@
 //! fill is a locked backdrop under the layers, drawn by resvg at the page's view
 //! ([`gradmesh_svg_picture::render_backdrop`]), with a message saying what cannot be edited. A
 //! PDF file's patch-mesh shadings become layers; what else its page holds is not drawn, and the
-//! message says what was left out.
+//! message says what was left out. The layers' colours are fitted to the file's own painting of
+//! its meshes, as `gradmesh convert --fit` fits them, up to [`MAX_FITTED_PATCHES`] patches.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use gradmesh::formats::{self, pdf, svg, Format};
-use gradmesh::render::RenderOptions;
-use gradmesh::{ColourSpace, Document, JoinTolerance, Limits, WarningKind};
+use gradmesh::render::{LayerSource, RenderOptions};
+use gradmesh::{
+    fit_joined_to_classic, ClassicFitOptions, ColourSpace, Document, JoinTolerance, Limits,
+    WarningKind,
+};
 use serde_json::{json, Value};
 
 use crate::viewer::Viewport;
@@ -80,15 +84,25 @@ pub fn read_svg(path: &Path) -> Result<Read, String> {
     let read = svg::read_document_with_limits(&text, ColourSpace::Lab, &limits)
         .map_err(|e| e.in_file(path).to_string())?;
     let tolerance = join_tolerance(&read.document);
-    let layers = gradmesh::join_meshes(&read.document.layers, tolerance);
-    let document = Document {
-        layers: layers.into_iter().map(|joined| joined.mesh).collect(),
-    };
+    let joined = gradmesh::join_meshes(&read.document.layers, tolerance);
+    let fills: Vec<Vec<LayerSource>> = joined
+        .iter()
+        .map(|j| {
+            j.sources
+                .iter()
+                .map(|&k| LayerSource::Classic(&read.fills[k]))
+                .collect()
+        })
+        .collect();
+    let mut layers: Vec<_> = joined.into_iter().map(|j| j.mesh).collect();
+    let pixels_per_unit = read.pixel_size.0 / read.view.width().max(1e-12);
+    let fit = fit_to_file(&mut layers, &fills, pixels_per_unit);
+    let document = Document { layers };
     let kinds = read.warnings.iter().map(|w| w.kind);
     let backdrop = Backdrop {
         path: path.to_path_buf(),
         svg_text: Some(text),
-        message: not_editable(path, kinds),
+        message: format!("{}. {fit}", not_editable(path, kinds)),
     };
     Ok(Read {
         document,
@@ -100,7 +114,19 @@ pub fn read_svg(path: &Path) -> Result<Read, String> {
 /// shading painted, and a backdrop that draws nothing but says what the page holds besides,
 /// when something was left out or read differently.
 pub fn read_pdf(path: &Path) -> Result<Read, String> {
-    let read = pdf::read_path_with_limits(path, 1, &Limits::DEFAULT).map_err(|e| e.to_string())?;
+    let mut read =
+        pdf::read_path_with_limits(path, 1, &Limits::DEFAULT).map_err(|e| e.to_string())?;
+    let fills: Vec<Vec<LayerSource>> = read
+        .picture
+        .fills
+        .iter()
+        .map(|fill| vec![LayerSource::Patches(fill)])
+        .collect();
+    let fit = fit_to_file(&mut read.document.layers, &fills, 1.0);
+    if fit != FITTED {
+        read.warnings
+            .push(gradmesh::Warning::new(WarningKind::PdfLeftOut, fit));
+    }
     let messages: Vec<&str> = read.warnings.iter().map(|w| w.message.as_str()).collect();
     let backdrop = (!messages.is_empty()).then(|| Backdrop {
         path: path.to_path_buf(),
@@ -112,6 +138,48 @@ pub fn read_pdf(path: &Path) -> Result<Read, String> {
         backdrop,
     })
 }
+
+/// The most patches a file's meshes may hold for the editor to fit their colours when it opens
+/// the file. The fit paints each fill and solves for every control colour and refined-level
+/// edit: the meshgradient test files (up to a few dozen patches) take 0.3-6 s each on a busy
+/// 2-core machine, and an SVG exported from a mesh (thousands of one-patch gradients) minutes.
+pub const MAX_FITTED_PATCHES: usize = 256;
+
+/// Fits the colours of `layers` (and colour edits at a refined level where the control colours
+/// cannot follow) to the file's own painting of the fills each holds, `fills[i]` for layer `i`,
+/// as `gradmesh convert --fit` does: the scheme's surface then looks as the file does, not as
+/// the plain conversion of its patches. `pixels_per_unit` is the file's scale (its fills are
+/// painted at that scale or finer). Layers of more than [`MAX_FITTED_PATCHES`] patches in all,
+/// or that the fit cannot take, are left as converted. Returns what the message says of it.
+fn fit_to_file(
+    layers: &mut [gradmesh::GradientMesh],
+    fills: &[Vec<LayerSource>],
+    pixels_per_unit: f64,
+) -> String {
+    let patches: usize = layers.iter().map(|l| l.faces.len()).sum();
+    if patches > MAX_FITTED_PATCHES {
+        return format!(
+            "Colours as converted, not fitted to the file's painting ({patches} patches, over \
+             {MAX_FITTED_PATCHES}; `gradmesh convert --fit` fits them)"
+        );
+    }
+    let fills: Vec<&[LayerSource]> = fills.iter().map(Vec::as_slice).collect();
+    let options = ClassicFitOptions {
+        pixels_per_unit,
+        ..ClassicFitOptions::default()
+    };
+    let mut fitted = layers.to_vec();
+    match fit_joined_to_classic(&mut fitted, &fills, &options) {
+        Ok(_) => {
+            layers.clone_from_slice(&fitted);
+            FITTED.to_string()
+        }
+        Err(e) => format!("Colours as converted: the fit to the file's painting failed ({e})"),
+    }
+}
+
+/// What the message says of colours fitted to the file's painting.
+const FITTED: &str = "Colours fitted to the file's own painting of its meshes";
 
 /// "NAME: only its patch-mesh shadings are read; left out or read differently: text is not
 /// drawn; …"
@@ -279,6 +347,78 @@ mod tests {
         );
         assert!(large.iter().sum::<usize>() * 100 > 95 * faces);
         assert!(doc.layers.len() * 50 < fills, "{} layers", doc.layers.len());
+    }
+
+    /// A meshgradient test file of the shared data (the test fails naming it when missing).
+    fn shared_svg(name: &str) -> PathBuf {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../../shared/realdata/meshgradient")
+            .join(name);
+        assert!(path.is_file(), "the test needs {}", path.display());
+        path
+    }
+
+    /// The mean difference, in 8-bit levels over the colour channels, between `layers` drawn
+    /// as the scheme and `fills` painted classically, over the pixels both cover opaquely, in a
+    /// 256-pixel-wide picture of `view`.
+    fn mean_difference(
+        layers: &[gradmesh::GradientMesh],
+        fills: &[svg::MeshFill],
+        view: kurbo::Rect,
+    ) -> f64 {
+        use gradmesh::render::{render_picture_into, PictureLayer, View};
+        let (w, h) = (256, (256.0 * view.height() / view.width()).ceil() as u32);
+        let opts = RenderOptions::new(w, h, View::from_rect(view));
+        let paint = |sources: Vec<LayerSource>| {
+            let layers: Vec<PictureLayer> = (sources.into_iter())
+                .map(|source| PictureLayer { source, clip: None })
+                .collect();
+            let mut out = vec![0f32; 4 * (w * h) as usize];
+            render_picture_into(&layers, &opts, &mut out).unwrap();
+            out
+        };
+        let scheme = paint(layers.iter().map(LayerSource::Scheme).collect());
+        let classic = paint(fills.iter().map(LayerSource::Classic).collect());
+        let (mut sum, mut count) = (0.0, 0usize);
+        for (a, b) in scheme.chunks_exact(4).zip(classic.chunks_exact(4)) {
+            if a[3] >= 1.0 && b[3] >= 1.0 {
+                sum += (0..3).map(|c| f64::from((a[c] - b[c]).abs())).sum::<f64>() / 3.0;
+                count += 1;
+            }
+        }
+        assert!(count > 1000, "{count} pixels covered by both");
+        255.0 * sum / count as f64
+    }
+
+    /// An SVG file opens with its layers' colours fitted to the file's own painting of its
+    /// meshes: the scheme's surface is drawn within a level of it, where the plain conversion
+    /// of the patches is several levels off.
+    #[test]
+    fn an_svg_opens_with_colours_fitted_to_its_painting() {
+        for name in [
+            "wpt/meshgradient-basic-003.svg",
+            "zectorio-mesh-gradient-js/sample4.svg",
+        ] {
+            let path = shared_svg(name);
+            let text = std::fs::read_to_string(&path).unwrap();
+            let plain =
+                svg::read_document_with_limits(&text, ColourSpace::Lab, &Limits::DEFAULT).unwrap();
+            let fitted = read_svg(&path).unwrap().document;
+            let faces = |layers: &[gradmesh::GradientMesh]| -> usize {
+                layers.iter().map(|l| l.faces.len()).sum()
+            };
+            assert_eq!(
+                faces(&fitted.layers),
+                faces(&plain.document.layers),
+                "{name}"
+            );
+            let before = mean_difference(&plain.document.layers, &plain.fills, plain.view);
+            let after = mean_difference(&fitted.layers, &plain.fills, plain.view);
+            assert!(
+                after < 1.0 && after < before / 3.0,
+                "{name}: {before} -> {after}"
+            );
+        }
     }
 
     #[test]

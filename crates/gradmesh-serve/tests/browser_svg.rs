@@ -140,7 +140,8 @@ async fn run_session(client: &Client, running: &Running) -> Result<(), String> {
         .to_string();
     assert!(
         message.starts_with("drawing.svg: not editable, drawn as a locked backdrop: ")
-            && message.contains("parts that are not mesh gradients left out"),
+            && message.contains("parts that are not mesh gradients left out")
+            && message.ends_with("Colours fitted to the file's own painting of its meshes"),
         "the message lists what is not editable: {message}"
     );
     let shown = js(

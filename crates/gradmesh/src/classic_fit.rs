@@ -54,31 +54,47 @@ pub fn fit_to_classic(
     sources: &[LayerSource<'_>],
     options: &ClassicFitOptions,
 ) -> Result<Vec<f64>, Error> {
+    let single: Vec<&[LayerSource<'_>]> = sources.iter().map(std::slice::from_ref).collect();
+    fit_joined_to_classic(layers, &single, options)
+}
+
+/// [`fit_to_classic`] for layers that each hold several fills, as [`crate::join_meshes`] joins
+/// them: `layers[i]` is fitted to the classic painting of the fills `sources[i]`, painted
+/// together in their order (the lowest first).
+pub fn fit_joined_to_classic(
+    layers: &mut [GradientMesh],
+    sources: &[&[LayerSource<'_>]],
+    options: &ClassicFitOptions,
+) -> Result<Vec<f64>, Error> {
     if layers.len() != sources.len() {
         return Err(Error::new(ErrorKind::Invalid {
             what: "fitted conversion".into(),
-            message: format!("{} layers for {} fills", layers.len(), sources.len()),
+            message: format!(
+                "{} layers for {} sets of fills",
+                layers.len(),
+                sources.len()
+            ),
         }));
     }
     layers
         .iter_mut()
         .zip(sources)
         .enumerate()
-        .map(|(i, (layer, source))| fit_layer(layer, *source, options).map_err(|e| e.in_layer(i)))
+        .map(|(i, (layer, fills))| fit_layer(layer, fills, options).map_err(|e| e.in_layer(i)))
         .collect()
 }
 
-/// [`fit_to_classic`] for one layer.
+/// [`fit_joined_to_classic`] for one layer.
 fn fit_layer(
     layer: &mut GradientMesh,
-    source: LayerSource<'_>,
+    fills: &[LayerSource<'_>],
     options: &ClassicFitOptions,
 ) -> Result<f64, Error> {
     let Some(extent) = mesh_extent(layer) else {
         return Ok(f64::INFINITY);
     };
     let (to_pixels, width, height) = picture_frame(extent, options);
-    let painting = paint_alone(source, to_pixels, width, height)?;
+    let painting = paint_alone(fills, to_pixels, width, height)?;
     let mut placed = transformed(layer, to_pixels);
     let psnr = match &options.detail {
         Some(detail) => {
@@ -125,10 +141,11 @@ fn picture_frame(extent: Rect, options: &ClassicFitOptions) -> (Affine, u32, u32
     (to_pixels, size(extent.width()), size(extent.height()))
 }
 
-/// `source` painted alone and unclipped into a `width` x `height` picture, the plane mapped to
-/// its pixels by `to_pixels` (a scale and a translation).
+/// The `fills` painted alone (without the rest of the picture), in order and unclipped, into a
+/// `width` x `height` picture, the plane mapped to its pixels by `to_pixels` (a scale and a
+/// translation).
 fn paint_alone(
-    source: LayerSource<'_>,
+    fills: &[LayerSource<'_>],
     to_pixels: Affine,
     width: u32,
     height: u32,
@@ -142,8 +159,11 @@ fn paint_alone(
     let mut opts = RenderOptions::new(width, height, View::new(a.x, a.y, b.x, b.y));
     opts.dither = false;
     let mut data = vec![0f32; 4 * width as usize * height as usize];
-    let layer = PictureLayer { source, clip: None };
-    render_picture_into(&[layer], &opts, &mut data)?;
+    let layers: Vec<PictureLayer> = fills
+        .iter()
+        .map(|&source| PictureLayer { source, clip: None })
+        .collect();
+    render_picture_into(&layers, &opts, &mut data)?;
     let pixels = data
         .chunks_exact(4)
         .map(|p| [p[0], p[1], p[2], p[3]])

@@ -61,7 +61,7 @@ mod union_find;
 mod validate;
 mod view;
 
-pub use classic_fit::{fit_to_classic, ClassicFitOptions};
+pub use classic_fit::{fit_joined_to_classic, fit_to_classic, ClassicFitOptions};
 pub use colour::{parse_css_colour, ColourSpace};
 pub use edit_check::EditSet;
 pub use error::{Error, ErrorKind, Location, Result, Warning, WarningKind};
