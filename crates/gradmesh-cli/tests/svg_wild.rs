@@ -179,6 +179,25 @@ fn a_whole_picture_over_the_memory_limit_is_refused() {
     assert!(out.status.success(), "{}", stderr(&out));
 }
 
+/// The mesh fill's tessellation counts against `--max-memory`, before it is made: F8 at 2000 px
+/// needs 60 MB for its canvas and PNG, and about 150 MB more for the cells of its mesh fill.
+#[test]
+fn the_mesh_fills_cells_count_against_the_memory_limit() {
+    let (out, dir) = render(
+        "F8-pdf-page-size-inkscape-ext-mesh.svg",
+        &["--width", "2000", "--max-memory", "100000000"],
+    );
+    let message = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{message}");
+    assert!(message.contains("mesh fills' cells"), "{message}");
+    assert!(!dir.path().join("out.png").exists());
+    let (out, _dir) = render(
+        "F8-pdf-page-size-inkscape-ext-mesh.svg",
+        &["--width", "2000", "--max-memory", "300000000"],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
 /// The bounding box (x0, y0, x1, y1) of the pixels where `is` holds.
 fn bounds(png: &Path, is: impl Fn(&[u8]) -> bool) -> Option<(u32, u32, u32, u32)> {
     let (w, _, data) = decode_png(png);

@@ -23,7 +23,7 @@ use std::collections::HashSet;
 use std::ops::Range;
 use std::path::Path;
 
-use gradmesh::render::{self, PictureLayer, RenderOptions};
+use gradmesh::render::{self, LayerSource, PictureLayer, RenderOptions};
 use gradmesh::{Error, ErrorKind};
 use roxmltree::{Document, Node};
 
@@ -344,6 +344,25 @@ pub fn bytes_per_pixel(sixteen: bool) -> u64 {
     }
 }
 
+/// The memory a cell of a mesh fill drawn classically takes while the fills of one run are
+/// drawn (its two triangles, its bins and its share of the fill's outline; `docs/svg.md`
+/// gives the peaks measured).
+const BYTES_PER_CELL: u64 = 350;
+
+/// The memory the tessellations of `layers`, prepared together, take: their cells
+/// ([`render::classic_cells`]) for SVG mesh fills drawn classically. Layers of the scheme are
+/// bounded by `opts.max_quads` instead.
+fn tessellation_bytes(layers: &[PictureLayer<'_>], opts: &RenderOptions) -> u64 {
+    layers
+        .iter()
+        .map(|layer| match layer.source {
+            LayerSource::Classic(fill) => render::classic_cells(fill, opts) as u64,
+            _ => 0,
+        })
+        .sum::<u64>()
+        .saturating_mul(BYTES_PER_CELL)
+}
+
 /// An error for a panic inside resvg or usvg.
 fn panicked(message: String) -> Error {
     Error::new(ErrorKind::Invalid {
@@ -358,7 +377,7 @@ fn check_memory(bytes: u64, max_memory: u64, opts: &RenderOptions) -> Result<(),
         return Err(Error::new(ErrorKind::LimitExceeded {
             what: format!(
                 "the memory the whole picture at {}x{} needs (estimated from its bytes a \
-                 pixel and resvg's layers; see --max-memory)",
+                 pixel, resvg's layers and the mesh fills' cells; see --max-memory)",
                 opts.width, opts.height
             ),
             found: bytes,
@@ -674,7 +693,13 @@ pub fn render_whole_picture(
     let mut run_start = 0;
     let mut draw_meshes_below = |end: usize, canvas: &mut Canvas| {
         if run_start < end {
-            let drawn = canvas.draw_meshes(&mesh_layers[run_start..end], opts)?;
+            let run = &mesh_layers[run_start..end];
+            check_memory(
+                base.saturating_add(tessellation_bytes(run, opts)),
+                max_memory,
+                opts,
+            )?;
+            let drawn = canvas.draw_meshes(run, opts)?;
             merge_info(&mut info, drawn, run_start);
             run_start = end;
         }

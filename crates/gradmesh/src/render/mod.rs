@@ -340,6 +340,14 @@ pub fn render_svg_scene(
     Ok((image, info))
 }
 
+/// The cells an SVG mesh fill drawn classically ([`LayerSource::Classic`]) is tessellated into
+/// at `opts`, before it is: a measure of the memory its drawing takes (a few hundred bytes a
+/// cell with its triangles and bins), for callers that check memory ahead.
+pub fn classic_cells(fill: &MeshFill, opts: &RenderOptions) -> usize {
+    let xf = ToPixels::new(&opts.view, opts.width, opts.height);
+    classic::cells(fill, opts, &xf)
+}
+
 /// Prepares the layers of a picture for drawing, in parallel: each from its source, with its
 /// clip; the first failing layer's error, whatever the thread count.
 fn prepare_picture(

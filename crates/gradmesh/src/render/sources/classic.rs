@@ -49,6 +49,16 @@ const REFERENCE_CELL_PX: f64 = 1.0;
 /// The most cells along one side of a patch.
 const MAX_CELLS_PER_SIDE: usize = 1024;
 
+/// The cells [`prepare`] tessellates `fill`'s mesh into with `opts`: each holds two triangles
+/// and its share of the bands' bins, what the layer's drawing keeps in memory.
+pub(crate) fn cells(fill: &MeshFill, opts: &RenderOptions, xf: &ToPixels) -> usize {
+    let k = match fill.mesh.kind {
+        MeshType::Bicubic => BICUBIC_SPLIT,
+        MeshType::Bilinear | MeshType::Coons => 1,
+    };
+    CellCounts::new(&fill.mesh, k, opts, xf).cells()
+}
+
 /// Prepares `fill`'s mesh for drawing with `opts` (never clipped: the caller adds the clip).
 /// A mesh whose patches need more cells than [`RenderOptions::max_quads`] at the least (one
 /// per patch, or one per lattice cell of `type="bicubic"`) is refused before any is made.
