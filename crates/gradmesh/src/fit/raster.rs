@@ -60,7 +60,9 @@ pub(crate) fn base_faces(refinement: &Refinement, depth: usize) -> Vec<u32> {
 
 impl Observation {
     /// Rasterises the quads of level `depth` (all quads: `depth >= 2`) with their corners at
-    /// `positions` (the level's limit positions, in pixels) over `target`.
+    /// `positions` (the level's limit positions, in pixels) over `target`. Where the surface
+    /// folds over itself, a pixel sees the last triangle over it, as the renderer draws it (and
+    /// as a later patch paints over an earlier one).
     pub fn new(
         refinement: &Refinement,
         depth: usize,
@@ -83,17 +85,30 @@ impl Observation {
             rhs: vec![[0.0; 3]; t.vertex_count()],
             mass: vec![0.0; t.vertex_count()],
         };
+        let mut triangles = Vec::with_capacity(2 * t.face_count());
+        let mut triangle_of = vec![UNCOVERED; pixels];
         for f in 0..t.face_count() {
             let v = t.face_vertices(f);
             for tri in [[v[0], v[1], v[2]], [v[0], v[2], v[3]]] {
-                obs.rasterise(tri, positions, target, faces[f]);
+                let index = triangles.len() as u32;
+                triangles.push(tri);
+                obs.rasterise(tri, positions, target, (faces[f], index), &mut triangle_of);
             }
         }
+        obs.sum_pixels(&triangles, &triangle_of, target);
         obs
     }
 
-    /// Rasterises one triangle: pixel centres inside it not yet taken by another.
-    fn rasterise(&mut self, tri: [u32; 3], positions: &[[f64; 2]], target: &Target, face: u32) {
+    /// Rasterises one triangle, number `index` of base face `face`: the pixel centres inside
+    /// it take it (over any earlier triangle).
+    fn rasterise(
+        &mut self,
+        tri: [u32; 3],
+        positions: &[[f64; 2]],
+        target: &Target,
+        (face, index): (u32, u32),
+        triangle_of: &mut [u32],
+    ) {
         let p = tri.map(|v| positions[v as usize]);
         let area =
             (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
@@ -110,15 +125,10 @@ impl Observation {
             ((m - 0.5).floor() + 1.0).clamp(0.0, size) as usize
         };
         let (x0, x1, y0, y1) = (lo(0, w), hi(0, w), lo(1, h), hi(1, h));
-        let mut moments = [0.0; 6];
-        let mut any = false;
         for y in y0..y1 {
             let cy = y as f64 + 0.5;
             for x in x0..x1 {
                 let i = y * target.width + x;
-                if self.samples[i].corners[0] != UNCOVERED {
-                    continue;
-                }
                 let cx = x as f64 + 0.5;
                 // Barycentric weights from the signed areas of the sub-triangles.
                 let edge = |a: [f64; 2], b: [f64; 2]| {
@@ -133,29 +143,43 @@ impl Observation {
                     bary: b.map(|l| l as f32),
                 };
                 self.base_face[i] = face;
-                let wt = target.weight[i];
-                if wt == 0.0 {
-                    continue;
-                }
-                any = true;
-                let b = b.map(|l| l as f32 as f64);
-                moments[0] += wt * b[0] * b[0];
-                moments[1] += wt * b[1] * b[1];
-                moments[2] += wt * b[2] * b[2];
-                moments[3] += wt * b[0] * b[1];
-                moments[4] += wt * b[0] * b[2];
-                moments[5] += wt * b[1] * b[2];
-                for k in 0..3 {
-                    let v = tri[k] as usize;
-                    self.mass[v] += wt * b[k];
-                    for c in 0..3 {
-                        self.rhs[v][c] += wt * b[k] * target.colour[i][c];
-                    }
+                triangle_of[i] = index;
+            }
+        }
+    }
+
+    /// Sums what the colour fit needs of the pixels: per triangle (`triangles[k]`, the one
+    /// `triangle_of` gives a pixel) the products of its pixels' weights, per vertex its share
+    /// of the pixels and of their target colours.
+    fn sum_pixels(&mut self, triangles: &[[u32; 3]], triangle_of: &[u32], target: &Target) {
+        let mut moments = vec![[0.0; 6]; triangles.len()];
+        let mut seen = vec![false; triangles.len()];
+        for (i, &k) in triangle_of.iter().enumerate() {
+            let wt = target.weight[i];
+            if k == UNCOVERED || wt == 0.0 {
+                continue;
+            }
+            let (tri, m) = (triangles[k as usize], &mut moments[k as usize]);
+            seen[k as usize] = true;
+            let b = self.samples[i].bary.map(f64::from);
+            m[0] += wt * b[0] * b[0];
+            m[1] += wt * b[1] * b[1];
+            m[2] += wt * b[2] * b[2];
+            m[3] += wt * b[0] * b[1];
+            m[4] += wt * b[0] * b[2];
+            m[5] += wt * b[1] * b[2];
+            for c in 0..3 {
+                let v = tri[c] as usize;
+                self.mass[v] += wt * b[c];
+                for (r, t) in self.rhs[v].iter_mut().zip(&target.colour[i]) {
+                    *r += wt * b[c] * t;
                 }
             }
         }
-        if any {
-            self.triangles.push((tri, moments));
+        for (k, &tri) in triangles.iter().enumerate() {
+            if seen[k] {
+                self.triangles.push((tri, moments[k]));
+            }
         }
     }
 
