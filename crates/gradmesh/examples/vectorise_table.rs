@@ -9,10 +9,11 @@
 //! ```text
 //! cargo run --release -p gradmesh --example vectorise_table -- \
 //!     [--out DIR] [--vtracer DIR] [--quality fast|default|best] [--budgets 256,1024] [--only NAME]
-//!     [--fixed-points]
+//!     [--fixed-points] [--unrounded]
 //! ```
 //!
-//! `--fixed-points` leaves the points where the quadtree puts them (`fit_positions` off).
+//! `--fixed-points` leaves the points where the quadtree puts them (`fit_positions` off);
+//! `--unrounded` writes positions and colours at full precision (`round_output` off).
 //!
 //! `--out DIR` writes the renders (`NAME-POINTS-mesh.png`, `NAME-POINTS-grid.png`,
 //! `NAME-vtracer-PRESET.png`), the fitted documents (`NAME-POINTS-mesh.json`) and the
@@ -208,6 +209,7 @@ struct Args {
     budgets: Vec<usize>,
     only: Option<String>,
     fit_positions: bool,
+    round_output: bool,
 }
 
 fn parse_args() -> Result<Args, Box<dyn Error>> {
@@ -218,6 +220,7 @@ fn parse_args() -> Result<Args, Box<dyn Error>> {
         budgets: vec![256, 1024],
         only: None,
         fit_positions: true,
+        round_output: true,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -227,6 +230,7 @@ fn parse_args() -> Result<Args, Box<dyn Error>> {
             "--vtracer" => args.vtracer = Some(value()?.into()),
             "--only" => args.only = Some(value()?),
             "--fixed-points" => args.fit_positions = false,
+            "--unrounded" => args.round_output = false,
             "--quality" => {
                 args.quality = match value()?.as_str() {
                     "fast" => Quality::Fast,
@@ -277,6 +281,7 @@ fn fit_rows(
         points: Some(budget),
         quality: args.quality,
         fit_positions: args.fit_positions,
+        round_output: args.round_output,
         ..VectoriseOptions::default()
     };
     let start = Instant::now();

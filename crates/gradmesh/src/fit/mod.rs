@@ -117,6 +117,10 @@ pub struct VectoriseOptions {
     /// colours solved again after each, kept only if the surface stays free of folds and the
     /// error falls). Points on the picture's sides slide along them; its corners stay.
     pub fit_positions: bool,
+    /// Round the output for a small file: positions to a tenth of a pixel, colours to a
+    /// thousandth of the colour space's lightness range (a tenth of a unit in Lab), far below
+    /// what the rendered picture shows.
+    pub round_output: bool,
 }
 
 impl Default for VectoriseOptions {
@@ -130,6 +134,7 @@ impl Default for VectoriseOptions {
             max_points: 1 << 15,
             min_cell_px: 3.0,
             fit_positions: true,
+            round_output: true,
         }
     }
 }
@@ -440,6 +445,9 @@ pub fn vectorise_with_progress(
                 )?;
             }
             fit.set_colours();
+            if options.round_output {
+                round_for_output(&mut fit.mesh);
+            }
             return finish(fit.mesh, image, round);
         }
         tree.split(&chosen);
@@ -685,15 +693,34 @@ fn choose_splits(
     chosen
 }
 
-/// The document of `mesh`, rendered at the picture's size to measure its PSNR.
-fn finish(mut mesh: GradientMesh, image: &RgbaImage, rounds: usize) -> Result<Vectorised, Error> {
-    // Two decimals (a hundredth of a pixel, of a Lab unit) are far below what the picture
-    // shows, and keep the file small.
-    let round = |v: f64| (v * 100.0).round() / 100.0;
-    for p in &mut mesh.points {
-        p.position = kurbo::Point::new(round(p.position.x), round(p.position.y));
-        p.colour = p.colour.map(round);
+/// Rounds `v` to `decimals` decimals, so that it is written in that many digits (the nearest
+/// double to a decimal fraction prints as that fraction) and never as `-0`.
+fn round_to_decimals(v: f64, decimals: i32) -> f64 {
+    let scale = 10f64.powi(decimals);
+    (v * scale).round() / scale + 0.0
+}
+
+/// The decimals a colour of `space` keeps: a thousandth of its lightness range.
+fn colour_decimals(space: ColourSpace) -> i32 {
+    match space {
+        ColourSpace::Lab => 1,
+        ColourSpace::Oklab | ColourSpace::SrgbLinear | ColourSpace::Srgb => 3,
     }
+}
+
+/// Rounds the positions of `mesh` to a tenth of a pixel and its colours to
+/// [`colour_decimals`]: what [`VectoriseOptions::round_output`] asks for.
+fn round_for_output(mesh: &mut GradientMesh) {
+    let decimals = colour_decimals(mesh.colour_space);
+    for p in &mut mesh.points {
+        let [x, y] = [p.position.x, p.position.y].map(|v| round_to_decimals(v, 1));
+        p.position = kurbo::Point::new(x, y);
+        p.colour = p.colour.map(|c| round_to_decimals(c, decimals));
+    }
+}
+
+/// The document of `mesh`, rendered at the picture's size to measure its PSNR.
+fn finish(mesh: GradientMesh, image: &RgbaImage, rounds: usize) -> Result<Vectorised, Error> {
     let points = mesh.points.len();
     let document = Document { layers: vec![mesh] };
     let view = View::new(0.0, 0.0, image.width as f64, image.height as f64);

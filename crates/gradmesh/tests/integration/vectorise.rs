@@ -314,3 +314,76 @@ fn moving_points_follows_an_edge() {
     let back = render(&moved.document, 96, 64);
     assert!(back.pixels.iter().all(|p| p[3] > 0.99));
 }
+
+/// A picture with smooth shading and a soft slanted edge, as photographs have.
+fn shaded_picture(w: u32, h: u32) -> RgbaImage {
+    let pixels = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
+            let (u, v) = (x / w as f32, y / h as f32);
+            let edge = 1.0 / (1.0 + (-(x - 0.6 * y - 0.3 * w as f32) / 2.0).exp());
+            let wave = 0.5 + 0.5 * (6.0 * u + 3.0 * v).sin();
+            [
+                0.2 + 0.6 * edge * u + 0.1 * wave,
+                0.3 + 0.4 * v * (1.0 - edge) + 0.2 * wave,
+                0.7 - 0.5 * edge + 0.1 * u,
+                1.0,
+            ]
+        })
+        .collect();
+    RgbaImage {
+        width: w,
+        height: h,
+        pixels,
+    }
+}
+
+/// Digits after the decimal point of every number in `text` after `key` (`"position": [..]`).
+fn decimals_after(text: &str, key: &str) -> Vec<usize> {
+    text.match_indices(key)
+        .flat_map(|(at, _)| {
+            let rest = &text[at + key.len()..];
+            let list = &rest[..rest.find(']').expect("a closed list")];
+            list.split(',')
+                .map(|n| n.trim().split('.').nth(1).map_or(0, str::len))
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
+/// The rounded output (a tenth of a pixel, a tenth of a Lab unit) renders within 0.1 dB of the
+/// unrounded one and its file is smaller; its numbers are written with at most one decimal.
+#[test]
+fn rounded_output_keeps_the_picture_in_a_smaller_file() {
+    let image = shaded_picture(120, 80);
+    let run = |round_output: bool| {
+        let options = VectoriseOptions {
+            points: Some(150),
+            round_output,
+            ..VectoriseOptions::default()
+        };
+        vectorise(&image, &options).unwrap()
+    };
+    let (exact, rounded) = (run(false), run(true));
+    assert!(
+        (exact.psnr - rounded.psnr).abs() < 0.1,
+        "rounded {} dB, unrounded {} dB",
+        rounded.psnr,
+        exact.psnr
+    );
+    let exact_text = gradmesh::formats::json::write_document(&exact.document);
+    let text = gradmesh::formats::json::write_document(&rounded.document);
+    assert!(
+        text.len() < exact_text.len() * 3 / 4,
+        "rounded {} bytes, unrounded {} bytes",
+        text.len(),
+        exact_text.len()
+    );
+    let positions = decimals_after(&text, "\"position\": [");
+    let colours = decimals_after(&text, "\"colour\": [");
+    assert_eq!(positions.len(), 2 * rounded.points);
+    assert_eq!(colours.len(), 3 * rounded.points);
+    assert!(positions.iter().chain(&colours).all(|&d| d <= 1));
+    let back = render(&rounded.document, 120, 80);
+    assert!((psnr(&image, &back).unwrap() - rounded.psnr).abs() < 0.5);
+}
