@@ -1,6 +1,6 @@
 //! Reading files, refining a mesh and its limit colours as a sparse matrix.
 
-use gradmesh::{formats, refine_level, LevelPoints, Limits};
+use gradmesh::{formats, refine_level, LevelPoints, Limits, VertexData};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -55,19 +55,18 @@ pub fn refine<'py>(
         offsets.push(corners.len() as i64);
     }
     let dict = PyDict::new(py);
-    dict.set_item("points", to_rows(py, flat(data, 0..2), 2))?;
-    dict.set_item("colours", to_rows(py, flat(data, 2..5), 3))?;
-    dict.set_item("opacity", to_vector(py, flat(data, 5..6)))?;
+    dict.set_item("points", to_rows(py, flat(data, |d| &d.position), 2))?;
+    dict.set_item("colours", to_rows(py, flat(data, |d| &d.colour), 3))?;
+    let opacity: Vec<f64> = data.iter().map(|d| d.opacity).collect();
+    dict.set_item("opacity", to_vector(py, opacity))?;
     dict.set_item("face_offsets", to_vector(py, offsets))?;
     dict.set_item("face_points", to_vector(py, corners))?;
     Ok(dict)
 }
 
-/// The channels `range` of every vertex, one vertex after the other.
-fn flat(data: &[[f64; 6]], range: std::ops::Range<usize>) -> Vec<f64> {
-    data.iter()
-        .flat_map(|d| d[range.clone()].to_vec())
-        .collect()
+/// The channels `field` picks of every vertex, one vertex after the other.
+fn flat(data: &[VertexData], field: impl Fn(&VertexData) -> &[f64]) -> Vec<f64> {
+    data.iter().flat_map(|d| field(d).iter().copied()).collect()
 }
 
 /// The limit colours of level `level`'s vertices as a sparse matrix of the points' colours

@@ -64,7 +64,7 @@ pub fn face_vertices(
         .map(|(point, at, v)| RefinedVertex {
             point,
             at,
-            position: [limit[v][0], limit[v][1]],
+            position: limit[v].position,
         })
         .collect())
 }
@@ -104,7 +104,7 @@ pub fn offset_for_move(
             .ok_or_else(|| format!("the address {address} names no vertex"))?;
         let data = refinement.evaluate();
         let limit = refinement.limit(&data, address.level as usize);
-        Ok(Vec2::new(limit[v][0], limit[v][1]))
+        Ok(Vec2::new(limit[v].position[0], limit[v].position[1]))
     };
     let here = limit_with(start)?;
     let along_u = limit_with(start + Vec2::new(1.0, 0.0))? - here;

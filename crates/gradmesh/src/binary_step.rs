@@ -190,16 +190,13 @@ pub fn binary_level(base: &BaseMesh) -> Level {
 /// The average of the data of some base vertices, at `position`: the colour and opacity of a
 /// point that is not in any control point's ring.
 fn blend(base: &BaseMesh, vertices: &[u32], position: Point) -> VertexData {
-    let mut d = [0.0; 6];
+    let mut d = VertexData::ZERO;
     for &v in vertices {
-        for (s, x) in d.iter_mut().zip(&base.data[v as usize]) {
-            *s += x;
-        }
+        d += base.data[v as usize];
     }
     let n = vertices.len() as f64;
-    d.iter_mut().for_each(|s| *s /= n);
-    d[0] = position.x;
-    d[1] = position.y;
+    d = d.map(|s| s / n);
+    d.position = [position.x, position.y];
     d
 }
 
@@ -245,18 +242,18 @@ pub fn colour_sources(t: &Topology) -> Vec<Vec<u32>> {
 ///   step's central polygon), with the average colour of the face's corners.
 pub fn binary_data(base: &BaseMesh) -> Vec<VertexData> {
     let t = &base.topology;
-    let mut out = vec![[0.0; 6]; level1_vertex_count(t)];
+    let mut out = vec![VertexData::ZERO; level1_vertex_count(t)];
     let pos = |v: u32| {
         let d = &base.data[v as usize];
-        Point::new(d[0], d[1])
+        d.point()
     };
     let with_position = |v: u32, p: Point| {
         let mut d = base.data[v as usize];
-        d[0] = p.x;
-        d[1] = p.y;
+        d.position[0] = p.x;
+        d.position[1] = p.y;
         d
     };
-    let at = |out: &[VertexData], i: u32| Point::new(out[i as usize][0], out[i as usize][1]);
+    let at = |out: &[VertexData], i: u32| out[i as usize].point();
     out[..t.vertex_count()].copy_from_slice(&base.data);
     for e in 0..t.edge_count() {
         let ends = t.edge_vertices(e);
@@ -323,16 +320,19 @@ mod tests {
     fn colours_are_the_means_of_their_sources() {
         let mut base = square_and_triangle();
         for (v, d) in base.data.iter_mut().enumerate() {
-            d[5] = 0.2 + 0.15 * v as f64;
+            d.opacity = 0.2 + 0.15 * v as f64;
         }
         let data = binary_data(&base);
         let sources = colour_sources(&base.topology);
         assert_eq!(sources.len(), data.len());
         for (d, src) in data.iter().zip(&sources) {
             for c in 2..6 {
-                let mean =
-                    src.iter().map(|&s| base.data[s as usize][c]).sum::<f64>() / src.len() as f64;
-                assert!((d[c] - mean).abs() < 1e-12, "{d:?} from {src:?}");
+                let mean = src
+                    .iter()
+                    .map(|&s| base.data[s as usize].to_array()[c])
+                    .sum::<f64>()
+                    / src.len() as f64;
+                assert!((d.to_array()[c] - mean).abs() < 1e-12, "{d:?} from {src:?}");
             }
         }
     }
@@ -379,7 +379,7 @@ mod tests {
         let base = square_and_triangle();
         let t = &base.topology;
         let d = binary_data(&base);
-        let at = |i: u32| Point::new(d[i as usize][0], d[i as usize][1]);
+        let at = |i: u32| Point::new(d[i as usize].position[0], d[i as usize].position[1]);
         let close = |i: u32, x: f64, y: f64| {
             let p = at(i);
             assert!(
@@ -444,7 +444,7 @@ mod tests {
         let x = [0.0, k * s, (1.0 + s - s1) / 2.0, 1.0 - k * s1, 1.0];
         let y = [0.0, k * r, (1.0 + r - r1) / 2.0, 1.0 - k * r1, 1.0];
         let grid = |(i, j): (i32, i32)| v0 + e1 * x[i as usize] + e2 * y[j as usize];
-        let p = |i: u32| Point::new(d[i as usize][0], d[i as usize][1]);
+        let p = |i: u32| Point::new(d[i as usize].position[0], d[i as usize].position[1]);
         let close = |i: u32, q: (i32, i32)| {
             let (got, want) = (p(i), grid(q));
             assert!(
@@ -518,7 +518,7 @@ mod tests {
             .iter_mut()
             .for_each(|h| *h = [Vec2::ZERO; 2]);
         let d = binary_data(&base);
-        assert!(d.iter().flatten().all(|x| x.is_finite()));
+        assert!(d.iter().flat_map(|d| d.to_array()).all(|x| x.is_finite()));
         // The ring collapses onto its control point.
         let t = &base.topology;
         assert_eq!(d[face_point(t, 0) as usize], base.data[0]);

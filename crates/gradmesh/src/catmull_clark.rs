@@ -75,7 +75,7 @@ impl Stencils {
 
     /// Applies the stencils to parent data.
     pub fn apply(&self, parent: &[VertexData]) -> Vec<VertexData> {
-        let mut out = vec![[0.0; 6]; self.len()];
+        let mut out = vec![VertexData::ZERO; self.len()];
         self.apply_into(parent, &mut out);
         out
     }
@@ -83,7 +83,7 @@ impl Stencils {
     /// [`Stencils::apply`] on the calling thread alone (see
     /// [`Topology::subdivide_sequential`]).
     pub(crate) fn apply_sequential(&self, parent: &[VertexData]) -> Vec<VertexData> {
-        let mut out = vec![[0.0; 6]; self.len()];
+        let mut out = vec![VertexData::ZERO; self.len()];
         self.apply_range(0, parent, &mut out);
         out
     }
@@ -92,12 +92,9 @@ impl Stencils {
     fn apply_range(&self, first: usize, parent: &[VertexData], out: &mut [VertexData]) {
         for (i, o) in out.iter_mut().enumerate() {
             let (src, w) = self.stencil(first + i);
-            let mut acc = [0.0; 6];
+            let mut acc = VertexData::ZERO;
             for (&s, &w) in src.iter().zip(w) {
-                let p = &parent[s as usize];
-                for c in 0..6 {
-                    acc[c] += w * p[c];
-                }
+                acc.add_scaled(&parent[s as usize], w);
             }
             *o = acc;
         }
@@ -305,7 +302,7 @@ pub fn refine_data(parent: &Level, data: &[VertexData]) -> Vec<VertexData> {
     let t = &parent.topology;
     let n = t.face_count() + t.edge_count() + t.vertex_count();
     let terms = stencil_terms(parent);
-    let mut out = vec![[0.0; 6]; n];
+    let mut out = vec![VertexData::ZERO; n];
     out.par_chunks_mut(STENCIL_CHUNK)
         .enumerate()
         .for_each(|(k, chunk)| {

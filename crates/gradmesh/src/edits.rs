@@ -309,7 +309,7 @@ impl BoundaryIndex {
     fn new(t: &Topology, data: &[VertexData]) -> Self {
         let mut by_x: Vec<(f64, u32)> = (0..t.vertex_count() as u32)
             .filter(|&w| t.is_boundary_vertex(w as usize))
-            .map(|w| (data[w as usize][0], w))
+            .map(|w| (data[w as usize].position[0], w))
             .collect();
         by_x.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         BoundaryIndex { by_x }
@@ -317,14 +317,14 @@ impl BoundaryIndex {
 
     /// The other boundary vertices at the position of `v`.
     fn copies(&self, data: &[VertexData], v: u32) -> Vec<u32> {
-        let p = data[v as usize];
+        let p = data[v as usize].position;
         let tol = 1e-12 * (1.0 + p[0].abs().max(p[1].abs()));
         let start = self.by_x.partition_point(|&(x, _)| x < p[0] - tol);
         self.by_x[start..]
             .iter()
             .take_while(|&&(x, _)| x <= p[0] + tol)
             .map(|&(_, w)| w)
-            .filter(|&w| w != v && (data[w as usize][1] - p[1]).abs() <= tol)
+            .filter(|&w| w != v && (data[w as usize].position[1] - p[1]).abs() <= tol)
             .collect()
     }
 }
@@ -364,10 +364,10 @@ pub(crate) fn apply(
         match l.edit.edit.colour {
             Some(ColourEdit::Set(c)) => {
                 let c = set.space.convert(working, c);
-                d[2..5].copy_from_slice(&c);
+                d.colour = c;
             }
             Some(ColourEdit::Offset(delta)) => {
-                let here = [old[2], old[3], old[4]];
+                let here = old.colour;
                 let target = if set.space == working {
                     [here[0] + delta[0], here[1] + delta[1], here[2] + delta[2]]
                 } else {
@@ -375,19 +375,19 @@ pub(crate) fn apply(
                     set.space
                         .convert(working, [c[0] + delta[0], c[1] + delta[1], c[2] + delta[2]])
                 };
-                d[2..5].copy_from_slice(&target);
+                d.colour = target;
             }
             None => {}
         }
         match l.edit.edit.opacity {
-            Some(OpacityEdit::Set(o)) => d[5] = o,
-            Some(OpacityEdit::Offset(o)) => d[5] = (old[5] + o).clamp(0.0, 1.0),
+            Some(OpacityEdit::Set(o)) => d.opacity = o,
+            Some(OpacityEdit::Offset(o)) => d.opacity = (old.opacity + o).clamp(0.0, 1.0),
             None => {}
         }
         if let (Some(off), Some([pi, pj])) = (l.edit.edit.offset, l.frame) {
             let edge = |[a, b]: [u32; 2]| {
-                let (p, q) = (data[a as usize], data[b as usize]);
-                Vec2::new(q[0] - p[0], q[1] - p[1])
+                let (p, q) = (data[a as usize].point(), data[b as usize].point());
+                q - p
             };
             let delta = edge(pi) * off.x + edge(pj) * off.y;
             moves.push((l.vertex, delta));
@@ -401,11 +401,12 @@ pub(crate) fn apply(
         writes.push((l.vertex, d));
     }
     for (v, d) in writes {
-        data[v as usize][2..6].copy_from_slice(&d[2..6]);
+        data[v as usize].colour = d.colour;
+        data[v as usize].opacity = d.opacity;
     }
     for (v, delta) in moves {
-        data[v as usize][0] += delta.x;
-        data[v as usize][1] += delta.y;
+        data[v as usize].position[0] += delta.x;
+        data[v as usize].position[1] += delta.y;
     }
 }
 
@@ -439,12 +440,12 @@ fn flatten_rings(
             let s = sums.entry(p).or_insert(([0.0; 3], 0, 0.0, 0));
             if l.edit.edit.colour.is_some() {
                 for c in 0..3 {
-                    s.0[c] += d[2 + c];
+                    s.0[c] += d.colour[c];
                 }
                 s.1 += 1;
             }
             if l.edit.edit.opacity.is_some() {
-                s.2 += d[5];
+                s.2 += d.opacity;
                 s.3 += 1;
             }
         }
@@ -452,12 +453,10 @@ fn flatten_rings(
     for (p, (c, nc, o, no)) in sums {
         let d = &mut next[p as usize];
         if nc > 0 {
-            for i in 0..3 {
-                d[2 + i] = c[i] / nc as f64;
-            }
+            d.colour = c.map(|c| c / nc as f64);
         }
         if no > 0 {
-            d[5] = o / no as f64;
+            d.opacity = o / no as f64;
         }
     }
 }

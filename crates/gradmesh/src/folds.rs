@@ -85,7 +85,7 @@ pub fn find_folds_at(refinement: &mut Refinement, data: &RefinedData, level: usi
     let lim = refinement.limit(data, k);
     let t = refinement.topology(k);
     let nf = t.face_count();
-    let p = |v: u32| Point::new(lim[v as usize][0], lim[v as usize][1]);
+    let p = |v: u32| lim[v as usize].point();
     let signed = |a: Point, b: Point, c: Point| 0.5 * (b - a).cross(c - a);
     let mut areas = Vec::with_capacity(nf);
     let mut total = 0.0;

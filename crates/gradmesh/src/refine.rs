@@ -371,7 +371,10 @@ impl Refinement {
                 .map(|v| {
                     let (src, w) = limit.stencil(self.vertex_at_level(v, depth));
                     src.iter().zip(w).fold([0.0; 2], |acc, (&s, &w)| {
-                        [acc[0] + w * d[s as usize][0], acc[1] + w * d[s as usize][1]]
+                        [
+                            acc[0] + w * d[s as usize].position[0],
+                            acc[1] + w * d[s as usize].position[1],
+                        ]
                     })
                 })
                 .collect()
@@ -379,14 +382,14 @@ impl Refinement {
         let before = limit_positions(level1);
         let mut shifted = level1.to_vec();
         for d in &mut shifted[..n] {
-            d[0] += 1.0;
-            d[1] += 1.0;
+            d.position[0] += 1.0;
+            d.position[1] += 1.0;
         }
         let after = limit_positions(&shifted);
         for v in 0..n {
             for c in 0..2 {
                 let weight = after[v][c] - before[v][c];
-                level1[v][c] += (base.data[v][c] - before[v][c]) / weight;
+                level1[v].position[c] += (base.data[v].position[c] - before[v][c]) / weight;
             }
         }
     }

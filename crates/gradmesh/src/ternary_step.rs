@@ -458,15 +458,15 @@ pub fn ternary_data(base: &BaseMesh) -> Vec<VertexData> {
 fn ternary_data_on(base: &BaseMesh, parallel: bool) -> Vec<VertexData> {
     let t = &base.topology;
     let (nv, ne) = (t.vertex_count(), t.edge_count());
-    let mut out = vec![[0.0; 6]; nv + 2 * ne + t.corner_count()];
+    let mut out = vec![VertexData::ZERO; nv + 2 * ne + t.corner_count()];
     let pos = |v: u32| {
         let d = &base.data[v as usize];
-        Point::new(d[0], d[1])
+        d.point()
     };
     let with_position = |v: u32, p: Point| {
         let mut d = base.data[v as usize];
-        d[0] = p.x;
-        d[1] = p.y;
+        d.position[0] = p.x;
+        d.position[1] = p.y;
         d
     };
     let (vertex_points, rest) = out.split_at_mut(nv);
@@ -604,7 +604,7 @@ mod tests {
         let sources = colour_sources(&base.topology);
         assert_eq!(sources.len(), data.len());
         for (d, &s) in data.iter().zip(&sources) {
-            assert_eq!(d[2..], base.data[s as usize][2..]);
+            assert_eq!(d.to_array()[2..], base.data[s as usize].to_array()[2..]);
         }
     }
 
@@ -654,11 +654,21 @@ mod tests {
         let t = &base.topology;
         assert!(t.corner_count() >= PARALLEL_MIN_CORNERS);
         let (one, many) = (ternary_data_on(&base, false), ternary_data_on(&base, true));
-        let bits = |d: &[VertexData]| d.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+        let bits = |d: &[VertexData]| {
+            d.iter()
+                .flat_map(|d| d.to_array())
+                .map(|x| x.to_bits())
+                .collect::<Vec<_>>()
+        };
         assert_eq!(bits(&one), bits(&many));
         assert_eq!(ternary_data(&base), many);
 
-        let pos = |v: u32| Point::new(base.data[v as usize][0], base.data[v as usize][1]);
+        let pos = |v: u32| {
+            Point::new(
+                base.data[v as usize].position[0],
+                base.data[v as usize].position[1],
+            )
+        };
         let handle = |e: u32, v: u32| base.edge_handles[e as usize][end_of(t, e, v)];
         for f in 0..t.face_count() {
             let (fv, fe) = (t.face_vertices(f), t.face_edges(f));
@@ -677,10 +687,10 @@ mod tests {
                 );
                 let d = many[face_point(t, t.face_offset(f) + i) as usize];
                 assert_eq!(
-                    [d[0].to_bits(), d[1].to_bits()],
+                    [d.position[0].to_bits(), d.position[1].to_bits()],
                     [p.x.to_bits(), p.y.to_bits()]
                 );
-                assert_eq!(d[2..], base.data[fv[i] as usize][2..]);
+                assert_eq!(d.to_array()[2..], base.data[fv[i] as usize].to_array()[2..]);
             }
         }
     }

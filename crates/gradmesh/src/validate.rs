@@ -5,7 +5,6 @@
 //! discontinuous edge are separate boundaries with their own colours and handles.
 
 use std::collections::{BTreeMap, HashMap};
-use std::ops::Range;
 
 use kurbo::{Point, Vec2};
 
@@ -20,37 +19,146 @@ pub use crate::scheme::{
     MAX_HANDLE_RATIO, MAX_INTERPOLATED_MAGNITUDE, MAX_MAGNITUDE, MIN_EDGE_LENGTH,
 };
 
-/// Per-vertex data carried through refinement: `[x, y, c0, c1, c2, opacity]`. A plain array,
-/// not a struct: refinement combines whole rows of them with the same weights.
-pub type VertexData = [f64; 6];
-
-/// Index of x in a [`VertexData`].
-pub const X: usize = 0;
-/// Index of y in a [`VertexData`].
-pub const Y: usize = 1;
-/// Indices of the three colour channels in a [`VertexData`].
-pub const COLOUR: Range<usize> = 2..5;
-/// Index of the opacity in a [`VertexData`].
-pub const OPACITY: usize = 5;
-
-/// The [`VertexData`] of a point at `position` with `colour` and `opacity`.
-pub fn vertex_data(position: Point, colour: [f64; 3], opacity: f64) -> VertexData {
-    let mut d = [0.0; 6];
-    d[X] = position.x;
-    d[Y] = position.y;
-    d[COLOUR].copy_from_slice(&colour);
-    d[OPACITY] = opacity;
-    d
+/// Per-vertex data carried through refinement: position, colour (three channels of the working
+/// space) and opacity. Refinement combines whole vertices with the same weights
+/// ([`VertexData::add_scaled`], the arithmetic operators); [`VertexData::to_array`] and
+/// [`VertexData::from_array`] give the flat form `[x, y, c0, c1, c2, opacity]`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct VertexData {
+    /// `[x, y]` in the plane of the mesh.
+    pub position: [f64; 2],
+    /// The three channels of the colour, in the mesh's working colour space.
+    pub colour: [f64; 3],
+    /// Opacity, 0 transparent to 1 opaque.
+    pub opacity: f64,
 }
 
-/// The colour and opacity of a [`VertexData`]: the attributes the renderer interpolates.
-pub fn attributes(d: &VertexData) -> [f64; 4] {
-    [
-        d[COLOUR.start],
-        d[COLOUR.start + 1],
-        d[COLOUR.start + 2],
-        d[OPACITY],
-    ]
+impl VertexData {
+    /// Zero in every coordinate: the start of a weighted sum.
+    pub const ZERO: VertexData = VertexData {
+        position: [0.0; 2],
+        colour: [0.0; 3],
+        opacity: 0.0,
+    };
+
+    /// The data of a point at `position` with `colour` and `opacity`.
+    pub fn new(position: Point, colour: [f64; 3], opacity: f64) -> Self {
+        VertexData {
+            position: [position.x, position.y],
+            colour,
+            opacity,
+        }
+    }
+
+    /// The data from its flat form `[x, y, c0, c1, c2, opacity]`.
+    #[inline]
+    pub fn from_array(a: [f64; 6]) -> Self {
+        VertexData {
+            position: [a[0], a[1]],
+            colour: [a[2], a[3], a[4]],
+            opacity: a[5],
+        }
+    }
+
+    /// The flat form `[x, y, c0, c1, c2, opacity]`.
+    #[inline]
+    pub fn to_array(&self) -> [f64; 6] {
+        let ([x, y], [c0, c1, c2]) = (self.position, self.colour);
+        [x, y, c0, c1, c2, self.opacity]
+    }
+
+    /// The position as a point.
+    #[inline]
+    pub fn point(&self) -> Point {
+        Point::new(self.position[0], self.position[1])
+    }
+
+    /// The colour and opacity: the attributes the renderer interpolates.
+    #[inline]
+    pub fn attributes(&self) -> [f64; 4] {
+        let [c0, c1, c2] = self.colour;
+        [c0, c1, c2, self.opacity]
+    }
+
+    /// `f` applied to every coordinate.
+    #[inline]
+    pub fn map(&self, f: impl FnMut(f64) -> f64) -> Self {
+        Self::from_array(self.to_array().map(f))
+    }
+
+    /// `f` applied to each pair of coordinates of `self` and `other`.
+    #[inline]
+    pub fn zip_with(&self, other: &Self, mut f: impl FnMut(f64, f64) -> f64) -> Self {
+        let (a, b) = (self.to_array(), other.to_array());
+        Self::from_array(std::array::from_fn(|k| f(a[k], b[k])))
+    }
+
+    /// Adds `w * other` to `self`, coordinate by coordinate: a term of a weighted sum.
+    #[inline]
+    pub fn add_scaled(&mut self, other: &Self, w: f64) {
+        self.position[0] += w * other.position[0];
+        self.position[1] += w * other.position[1];
+        self.colour[0] += w * other.colour[0];
+        self.colour[1] += w * other.colour[1];
+        self.colour[2] += w * other.colour[2];
+        self.opacity += w * other.opacity;
+    }
+
+    /// The weighted sum of `terms`, added in order from zero.
+    #[inline]
+    pub fn weighted_sum<'a>(terms: impl IntoIterator<Item = (&'a VertexData, f64)>) -> Self {
+        let mut sum = Self::ZERO;
+        for (d, w) in terms {
+            sum.add_scaled(d, w);
+        }
+        sum
+    }
+
+    /// The point a fraction `t` of the way from `self` to `other`: `self + t * (other - self)`.
+    #[inline]
+    pub fn lerp(&self, other: &Self, t: f64) -> Self {
+        self.zip_with(other, |a, b| a + t * (b - a))
+    }
+}
+
+impl std::ops::Add for VertexData {
+    type Output = VertexData;
+    #[inline]
+    fn add(self, other: VertexData) -> VertexData {
+        self.zip_with(&other, |a, b| a + b)
+    }
+}
+
+impl std::ops::Sub for VertexData {
+    type Output = VertexData;
+    #[inline]
+    fn sub(self, other: VertexData) -> VertexData {
+        self.zip_with(&other, |a, b| a - b)
+    }
+}
+
+impl std::ops::Mul<f64> for VertexData {
+    type Output = VertexData;
+    #[inline]
+    fn mul(self, w: f64) -> VertexData {
+        self.map(|a| a * w)
+    }
+}
+
+impl std::ops::Mul<VertexData> for f64 {
+    type Output = VertexData;
+    #[inline]
+    fn mul(self, d: VertexData) -> VertexData {
+        d.map(|a| self * a)
+    }
+}
+
+impl std::ops::AddAssign for VertexData {
+    #[inline]
+    fn add_assign(&mut self, other: VertexData) {
+        *self = *self + other;
+    }
 }
 
 /// The validated base level: topology with discontinuities split, and the data on it.
@@ -357,7 +465,7 @@ impl Wedges {
             .iter()
             .map(|&p| {
                 let cp = &mesh.points[p as usize];
-                vertex_data(cp.position, cp.colour, cp.opacity)
+                VertexData::new(cp.position, cp.colour, cp.opacity)
             })
             .collect()
     }
@@ -446,9 +554,9 @@ fn apply_wedge_entries<'m>(
         }
         overridden[id] = true;
         let d = &mut data[id];
-        d[COLOUR].copy_from_slice(&w.colour);
+        d.colour = w.colour;
         if let Some(o) = w.opacity {
-            d[OPACITY] = o;
+            d.opacity = o;
         }
         for (&to, &h) in &w.handles {
             if !has_edge(whole, w.point, to) {

@@ -39,7 +39,7 @@ pub fn run(args: &EditsArgs, report: &mut super::WarningReport) -> Result<(), Er
             let place = match vertex {
                 Some(v) => {
                     let d = data.levels[a.level as usize][v];
-                    format!("vertex {v} at ({:.3}, {:.3})", d[0], d[1])
+                    format!("vertex {v} at ({:.3}, {:.3})", d.position[0], d.position[1])
                 }
                 None => "no vertex".to_string(),
             };

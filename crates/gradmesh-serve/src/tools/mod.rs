@@ -115,12 +115,13 @@ impl SurfaceSamples {
 
     /// The colour and opacity (within 0 to 1) of the sample nearest `at`.
     pub fn nearest(&self, at: Point) -> Option<([f64; 3], f64)> {
-        let distance = |s: &VertexData| (s[0] - at.x).powi(2) + (s[1] - at.y).powi(2);
+        let distance =
+            |s: &VertexData| (s.position[0] - at.x).powi(2) + (s.position[1] - at.y).powi(2);
         self.samples
             .iter()
             .min_by(|a, b| distance(a).total_cmp(&distance(b)))
             // Rounding can take a limit opacity of 1 a little past it.
-            .map(|s| ([s[2], s[3], s[4]], s[5].clamp(0.0, 1.0)))
+            .map(|s| (s.colour, s.opacity.clamp(0.0, 1.0)))
     }
 }
 

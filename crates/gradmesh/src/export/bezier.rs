@@ -20,13 +20,13 @@ const BSPLINE_TO_BEZIER: [[f64; 4]; 4] = [
 /// The Bézier net of the uniform bicubic B-spline patch of `cp`: `B = M P Mᵀ` in every
 /// coordinate.
 pub(crate) fn bspline_to_bezier(cp: &ControlGrid) -> BezierNet {
-    let mut rows = [[[0.0; 6]; 4]; 4];
+    let mut rows = [[VertexData::ZERO; 4]; 4];
     for (j, row) in cp.iter().enumerate() {
         for (i, m) in BSPLINE_TO_BEZIER.iter().enumerate() {
             rows[j][i] = combine(m, |k| row[k]);
         }
     }
-    let mut net = [[[0.0; 6]; 4]; 4];
+    let mut net = [[VertexData::ZERO; 4]; 4];
     for (j, m) in BSPLINE_TO_BEZIER.iter().enumerate() {
         for i in 0..4 {
             net[j][i] = combine(m, |k| rows[k][i]);
@@ -37,13 +37,10 @@ pub(crate) fn bspline_to_bezier(cp: &ControlGrid) -> BezierNet {
 
 /// `Σ w[k] p(k)` over four points.
 fn combine(w: &[f64; 4], p: impl Fn(usize) -> VertexData) -> VertexData {
-    let mut out = [0.0; 6];
+    let mut out = VertexData::ZERO;
     for (k, &wk) in w.iter().enumerate() {
         if wk != 0.0 {
-            let q = p(k);
-            for c in 0..6 {
-                out[c] += wk * q[c];
-            }
+            out.add_scaled(&p(k), wk);
         }
     }
     out
@@ -68,9 +65,7 @@ fn blossom(p: &[VertexData; 4], t: [f64; 3]) -> VertexData {
     let mut q = *p;
     for (step, &ts) in t.iter().enumerate() {
         for k in 0..3 - step {
-            for c in 0..6 {
-                q[k][c] = (1.0 - ts) * q[k][c] + ts * q[k + 1][c];
-            }
+            q[k] = q[k].zip_with(&q[k + 1], |a, b| (1.0 - ts) * a + ts * b);
         }
     }
     q[0]
@@ -88,11 +83,11 @@ fn segment(p: &[VertexData; 4], a: f64, b: f64) -> [VertexData; 4] {
 
 /// The patch over `u0..=u1` x `v0..=v1`, reparametrised to the unit square.
 pub(crate) fn sub_net(net: &BezierNet, (u0, u1): (f64, f64), (v0, v1): (f64, f64)) -> BezierNet {
-    let mut rows = [[[0.0; 6]; 4]; 4];
+    let mut rows = [[VertexData::ZERO; 4]; 4];
     for j in 0..4 {
         rows[j] = segment(&net[j], u0, u1);
     }
-    let mut out = [[[0.0; 6]; 4]; 4];
+    let mut out = [[VertexData::ZERO; 4]; 4];
     for i in 0..4 {
         let column = [rows[0][i], rows[1][i], rows[2][i], rows[3][i]];
         let cut = segment(&column, v0, v1);
@@ -106,7 +101,7 @@ pub(crate) fn sub_net(net: &BezierNet, (u0, u1): (f64, f64), (v0, v1): (f64, f64
 /// The flat patch with corners `c` at `(0, 0)`, `(1, 0)`, `(1, 1)` and `(0, 1)`: bilinear in
 /// every coordinate.
 pub(crate) fn bilinear_net(c: [VertexData; 4]) -> BezierNet {
-    let mut net = [[[0.0; 6]; 4]; 4];
+    let mut net = [[VertexData::ZERO; 4]; 4];
     for j in 0..4 {
         let v = j as f64 / 3.0;
         for i in 0..4 {
@@ -127,20 +122,23 @@ mod tests {
         std::array::from_fn(|j| {
             std::array::from_fn(|i| {
                 let x = (4 * j + i) as f64;
-                [
+                VertexData::from_array([
                     10.0 * i as f64 + (x * 0.7).sin(),
                     10.0 * j as f64 + (x * 1.3).cos(),
                     50.0 + 20.0 * (x * 0.37).sin(),
                     x * x * 0.3 - 20.0,
                     -30.0 * (x * 0.11).cos(),
                     0.5 + 0.4 * (x * 0.5).sin(),
-                ]
+                ])
             })
         })
     }
 
     fn close(a: VertexData, b: VertexData, tol: f64) -> bool {
-        a.iter().zip(&b).all(|(x, y)| (x - y).abs() <= tol)
+        a.to_array()
+            .iter()
+            .zip(&b.to_array())
+            .all(|(x, y)| (x - y).abs() <= tol)
     }
 
     #[test]
@@ -183,10 +181,10 @@ mod tests {
 
     #[test]
     fn bilinear_net_is_bilinear() {
-        let c = [[0.0; 6], [4.0; 6], [10.0; 6], [2.0; 6]];
+        let c = [0.0, 4.0, 10.0, 2.0].map(|x| VertexData::from_array([x; 6]));
         let net = bilinear_net(c);
         let p = evaluate(&net, 0.25, 0.5);
         let want = 0.375 * 0.0 + 0.125 * 4.0 + 0.125 * 10.0 + 0.375 * 2.0;
-        assert!((p[3] - want).abs() < 1e-12);
+        assert!((p.colour[1] - want).abs() < 1e-12);
     }
 }

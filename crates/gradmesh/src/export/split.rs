@@ -114,15 +114,15 @@ impl Splitter {
     /// Counts from the bound on the bilinear error (see the module documentation).
     fn initial_counts(&self, net: &BezierNet) -> (usize, usize) {
         let centre = evaluate(net, 0.5, 0.5);
-        let j = self.space.lab_jacobian([centre[2], centre[3], centre[4]]);
+        let j = self.space.lab_jacobian(centre.colour);
         let scale = j.iter().flatten().map(|x| x * x).sum::<f64>().sqrt();
         let second = |a: VertexData, b: VertexData, c: VertexData| {
-            let colour = (2..5)
-                .map(|k| (a[k] - 2.0 * b[k] + c[k]).powi(2))
+            let colour = (0..3)
+                .map(|k| (a.colour[k] - 2.0 * b.colour[k] + c.colour[k]).powi(2))
                 .sum::<f64>()
                 .sqrt();
             let opacity = if self.opacity {
-                OPACITY_WEIGHT * (a[5] - 2.0 * b[5] + c[5]).abs()
+                OPACITY_WEIGHT * (a.opacity - 2.0 * b.opacity + c.opacity).abs()
             } else {
                 0.0
             };
@@ -146,14 +146,14 @@ impl Splitter {
     /// the sRGB gamut are mapped into it as the renderer maps them (chroma reduced in Oklch),
     /// rather than left for each viewer to clip.
     fn colours(&self, p: &VertexData) -> ([f64; 3], [f64; 3], f64) {
-        let c = [p[2], p[3], p[4]];
+        let c = p.colour;
         let srgb = to_blend_space(self.space, c, GamutMapping::default(), BlendSpace::Srgb);
         let lab = ColourSpace::Srgb.convert(ColourSpace::Lab, srgb);
         let target = match self.target {
             Target::Lab => lab,
             Target::Srgb => srgb,
         };
-        (target, lab, p[5])
+        (target, lab, p.opacity)
     }
 
     /// The largest error over the samples of every cell, and the parts of the error along `u`
@@ -226,9 +226,9 @@ impl Splitter {
                 let at = |di: usize, dj: usize| corners[(j + dj) * (n + 1) + i + di];
                 let c = [at(0, 0), at(1, 0), at(1, 1), at(0, 1)];
                 out.push(OutPatch {
-                    points: cell.map(|row| row.map(|p| [p[0], p[1]])),
+                    points: cell.map(|row| row.map(|p| p.position)),
                     colours: c.map(|p| self.colours(&p).0),
-                    opacity: c.map(|p| p[5]),
+                    opacity: c.map(|p| p.opacity),
                 });
             }
         }
@@ -280,14 +280,11 @@ mod tests {
                         0.1 + 0.8 * rng.next(),
                     ],
                 };
-                [
-                    40.0 * i as f64 / 3.0,
-                    40.0 * j as f64 / 3.0,
-                    colour[0],
-                    colour[1],
-                    colour[2],
-                    0.3 + 0.7 * rng.next(),
-                ]
+                VertexData {
+                    position: [40.0 * i as f64 / 3.0, 40.0 * j as f64 / 3.0],
+                    colour,
+                    opacity: 0.3 + 0.7 * rng.next(),
+                }
             })
         })
     }
@@ -320,13 +317,11 @@ mod tests {
                 std::array::from_fn(|ch| (0..4).map(|k| w[k] * cell.colours[k][ch]).sum());
             let alpha: f64 = (0..4).map(|k| w[k] * cell.opacity[k]).sum();
             let truth = evaluate(net, u, v);
-            let lab = s
-                .space
-                .convert(ColourSpace::Lab, [truth[2], truth[3], truth[4]]);
+            let lab = s.space.convert(ColourSpace::Lab, truth.colour);
             let shown = s.target.space().convert(ColourSpace::Lab, mix);
             worst = worst
                 .max(delta_e00(shown, lab))
-                .max(OPACITY_WEIGHT * (alpha - truth[5]).abs());
+                .max(OPACITY_WEIGHT * (alpha - truth.opacity).abs());
         }
         worst
     }
@@ -384,8 +379,8 @@ mod tests {
                 let c = &cells[j * n + i];
                 let at = evaluate(&net, i as f64 / n as f64, j as f64 / m as f64);
                 assert!(
-                    (c.points[0][0][0] - at[0]).abs() < 1e-9
-                        && (c.points[0][0][1] - at[1]).abs() < 1e-9
+                    (c.points[0][0][0] - at.position[0]).abs() < 1e-9
+                        && (c.points[0][0][1] - at.position[1]).abs() < 1e-9
                 );
                 if i + 1 < n {
                     let right = &cells[j * n + i + 1];

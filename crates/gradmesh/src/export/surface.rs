@@ -93,8 +93,8 @@ pub(crate) fn layer_surface(
     let px: Vec<VertexData> = data.levels[k]
         .iter()
         .map(|d| {
-            let [x, y] = opts.xf.apply(d[0], d[1]);
-            [x, y, d[2], d[3], d[4], d[5]]
+            let position = opts.xf.apply(d.position[0], d.position[1]);
+            VertexData { position, ..*d }
         })
         .collect();
     let level = refinement.level(k);
@@ -102,7 +102,7 @@ pub(crate) fn layer_surface(
         space: mesh.colour_space,
         nets: Vec::new(),
         outline: outline_curves(level, &px),
-        opaque: px.iter().all(|d| d[5] >= OPAQUE),
+        opaque: px.iter().all(|d| d.opacity >= OPAQUE),
         approximated: 0,
         geometry_error: 0.0,
         warnings: warnings
@@ -145,7 +145,7 @@ fn reaches_page(level: &Level, px: &[VertexData], f: usize, opts: &SurfaceOption
     for &c in t.face_vertices(f) {
         for &g in t.vertex_faces(c as usize) {
             for &v in t.face_vertices(g as usize) {
-                let p = px[v as usize];
+                let p = px[v as usize].position;
                 for k in 0..2 {
                     lo[k] = lo[k].min(p[k]);
                     hi[k] = hi[k].max(p[k]);
@@ -205,11 +205,10 @@ fn local_nets(
 }
 
 fn average(points: &[VertexData]) -> VertexData {
-    let mut out = [0.0; 6];
+    let n = points.len() as f64;
+    let mut out = VertexData::ZERO;
     for p in points {
-        for k in 0..6 {
-            out[k] += p[k] / points.len() as f64;
-        }
+        out += p.map(|x| x / n);
     }
     out
 }
@@ -217,9 +216,12 @@ fn average(points: &[VertexData]) -> VertexData {
 /// The distance in pixels between two samples, and the larger of their colour difference
 /// (ΔE00) and a hundred times their opacity difference.
 fn difference(space: ColourSpace, a: &VertexData, b: &VertexData) -> (f64, f64) {
-    let lab = |d: &VertexData| space.convert(ColourSpace::Lab, [d[2], d[3], d[4]]);
-    let colour = delta_e00(lab(a), lab(b)).max(100.0 * (a[5] - b[5]).abs());
-    ((a[0] - b[0]).hypot(a[1] - b[1]), colour)
+    let lab = |d: &VertexData| space.convert(ColourSpace::Lab, d.colour);
+    let colour = delta_e00(lab(a), lab(b)).max(100.0 * (a.opacity - b.opacity).abs());
+    (
+        (a.position[0] - b.position[0]).hypot(a.position[1] - b.position[1]),
+        colour,
+    )
 }
 
 /// Outline points are snapped to 2^-16 pixel before conversion, as the renderer's are: the
@@ -235,8 +237,9 @@ fn outline_curves(level: &Level, px: &[VertexData]) -> Vec<Vec<Curve>> {
     for lp in boundary_loops(&level.topology) {
         let m = lp.len();
         let pos = |i: usize| {
-            let d = px[lp[i % m] as usize];
-            [d[0], d[1]].map(|v| (v * OUTLINE_GRID).round() / OUTLINE_GRID)
+            px[lp[i % m] as usize]
+                .position
+                .map(|v| (v * OUTLINE_GRID).round() / OUTLINE_GRID)
         };
         for_each_boundary_segment(level, &lp, pos, |q| curves.push(bezier_segment(q)));
     }

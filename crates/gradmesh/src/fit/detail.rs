@@ -316,7 +316,7 @@ mod tests {
             for (g, e) in got.iter().zip(&expected) {
                 for k in 0..3 {
                     assert!(
-                        (g[k] - e[2 + k]).abs() < 1e-9,
+                        (g[k] - e.to_array()[2 + k]).abs() < 1e-9,
                         "level {level}: {g:?} vs {e:?}"
                     );
                 }

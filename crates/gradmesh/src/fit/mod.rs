@@ -265,7 +265,7 @@ fn fit_refined(
     let positions: Vec<[f64; 2]> = limit
         .apply(&data.levels[depth])
         .iter()
-        .map(|d| [d[0], d[1]])
+        .map(|d| d.position)
         .collect();
     drop(data);
     let points = mesh.points.len();

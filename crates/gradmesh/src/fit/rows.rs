@@ -288,7 +288,7 @@ mod tests {
             assert_eq!(got.len(), expected.len());
             for (g, e) in got.iter().zip(&expected) {
                 for k in 0..3 {
-                    assert!((g[k] - e[2 + k]).abs() < 1e-9, "{g:?} vs {e:?}");
+                    assert!((g[k] - e.to_array()[2 + k]).abs() < 1e-9, "{g:?} vs {e:?}");
                 }
             }
         }

@@ -1485,9 +1485,9 @@ pub fn write_refined(layers: &[RefinedLayer]) -> String {
         fields.push(("colour_space", string(layer.colour_space.name())));
         let points = layer.data.iter().map(|d| {
             inline_object(&[
-                ("position", numbers(&d[0..2])),
-                ("colour", numbers(&d[2..5])),
-                ("opacity", num(d[5])),
+                ("position", numbers(&d.position)),
+                ("colour", numbers(&d.colour)),
+                ("opacity", num(d.opacity)),
             ])
         });
         fields.push(("points", block_array(6, points)));
@@ -1831,7 +1831,8 @@ mod tests {
             [0.0, 0.0, 50.0, 0.0, 0.0, 1.0],
             [1.0, 0.0, 60.0, 1.0, 2.0, 0.5],
             [0.0, 1.0, 70.0, -1.0, 0.0, 1.0],
-        ];
+        ]
+        .map(VertexData::from_array);
         let text = write_refined(&[RefinedLayer {
             name: Some("a"),
             colour_space: ColourSpace::Lab,

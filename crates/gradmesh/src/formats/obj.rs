@@ -557,7 +557,8 @@ pub fn write_refined_obj_to(
                     let mut num = ryu::Buffer::new();
                     for d in block {
                         s.push('v');
-                        for (k, &x) in [d[0], d[1], 0.0, d[2], d[3], d[4]].iter().enumerate() {
+                        let ([x, y], [c0, c1, c2]) = (d.position, d.colour);
+                        for (k, &x) in [x, y, 0.0, c0, c1, c2].iter().enumerate() {
                             s.push(' ');
                             if k == 2 {
                                 s.push('0');
@@ -734,7 +735,8 @@ t interpolateboundary 1/0/0 2
             [0.0, 0.0, 50.0, 0.0, 0.0, 1.0],
             [1.5, 0.0, 60.0, 0.1, 2.0, 0.5],
             [0.0, 1e-7, 70.0, -1.0, 0.0, 1.0],
-        ];
+        ]
+        .map(VertexData::from_array);
         let text = write_refined_obj(&[(Some("a"), &topology, &data), (None, &topology, &data)]);
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines[1], "o a");

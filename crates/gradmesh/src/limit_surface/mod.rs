@@ -182,6 +182,7 @@ mod tests {
     use super::*;
     use crate::mesh::{CreasingMethod, SHARPNESS_INFINITE};
     use crate::topology::Topology;
+    use crate::validate::VertexData;
 
     /// The dart mask equals the position of the vertex after many levels of refinement.
     #[test]
@@ -211,10 +212,10 @@ mod tests {
                 creasing: CreasingMethod::Uniform,
             };
             assert_eq!(level.vertex_rule(0), VertexRule::Dart);
-            let data: Vec<[f64; 6]> = (0..nv)
+            let data: Vec<VertexData> = (0..nv)
                 .map(|i| {
                     let x = (i as f64 * 1.7).sin() * 3.0 + i as f64;
-                    [x, (i as f64 * 0.9).cos() * 5.0, x * x, 0.0, 0.0, 1.0]
+                    VertexData::from_array([x, (i as f64 * 0.9).cos() * 5.0, x * x, 0.0, 0.0, 1.0])
                 })
                 .collect();
             // The limit of the vertex is the same whichever level it is computed from, and the
@@ -222,7 +223,8 @@ mod tests {
             let mask = limit_stencils(&level).unwrap().apply(&data)[0];
             let mut d = data.clone();
             let mut index = 0usize;
-            let first_gap = (d[0][0] - mask[0]).hypot(d[0][1] - mask[1]);
+            let first_gap =
+                (d[0].position[0] - mask.position[0]).hypot(d[0].position[1] - mask.position[1]);
             let mut gap = first_gap;
             for _ in 0..6 {
                 let (child, st) = refine(&level);
@@ -232,11 +234,13 @@ mod tests {
                 let again = limit_stencils(&level).unwrap().apply(&d)[index];
                 for c in 0..3 {
                     assert!(
-                        (mask[c] - again[c]).abs() < 1e-12 * (1.0 + mask[c].abs()),
+                        (mask.to_array()[c] - again.to_array()[c]).abs()
+                            < 1e-12 * (1.0 + mask.to_array()[c].abs()),
                         "n {n}: {mask:?} vs {again:?}"
                     );
                 }
-                gap = (d[index][0] - mask[0]).hypot(d[index][1] - mask[1]);
+                gap = (d[index].position[0] - mask.position[0])
+                    .hypot(d[index].position[1] - mask.position[1]);
             }
             assert!(gap < 0.2 * first_gap, "n {n}: {gap} after {first_gap}");
         }

@@ -58,13 +58,10 @@ pub(crate) fn bspline_basis(t: f64) -> [f64; 4] {
 #[cfg(test)]
 pub(crate) fn evaluate_patch_at(cp: &ControlGrid, u: f64, v: f64) -> VertexData {
     let (bu, bv) = (bspline_basis(u), bspline_basis(v));
-    let mut p = [0.0; 6];
+    let mut p = VertexData::ZERO;
     for (j, row) in cp.iter().enumerate() {
         for (i, point) in row.iter().enumerate() {
-            let w = bu[i] * bv[j];
-            for k in 0..6 {
-                p[k] += w * point[k];
-            }
+            p.add_scaled(point, bu[i] * bv[j]);
         }
     }
     p
@@ -99,20 +96,16 @@ fn evaluate_patch_with(cp: &ControlGrid, n: usize, mut put: impl FnMut(usize, us
     }
     for (j, bv) in basis.iter().enumerate() {
         // The four columns collapsed to this row's curve first: 16 then 4 terms per sample.
-        let mut q = [[0.0; 6]; 4];
+        let mut q = [VertexData::ZERO; 4];
         for (i, qi) in q.iter_mut().enumerate() {
             for (j, row) in cp.iter().enumerate() {
-                for k in 0..6 {
-                    qi[k] += bv[j] * row[i][k];
-                }
+                qi.add_scaled(&row[i], bv[j]);
             }
         }
         for (i, bu) in basis.iter().enumerate() {
-            let mut p = [0.0; 6];
+            let mut p = VertexData::ZERO;
             for (i, qi) in q.iter().enumerate() {
-                for k in 0..6 {
-                    p[k] += bu[i] * qi[k];
-                }
+                p.add_scaled(qi, bu[i]);
             }
             put(i, j, p);
         }
@@ -248,7 +241,7 @@ fn regular_patch_points(
 /// The control grid of a regular patch whose points are `points` ([`regular_patch_points`]),
 /// reading the data of point `v` as `data(v)`, with the phantoms reflected.
 fn control_grid(points: &PatchPoints, data: impl Fn(u32) -> VertexData) -> ControlGrid {
-    let mut cp = [[[0.0; 6]; 4]; 4];
+    let mut cp = [[VertexData::ZERO; 4]; 4];
     let mut real = [[false; 4]; 4];
     for j in 0..4 {
         for i in 0..4 {
@@ -258,13 +251,8 @@ fn control_grid(points: &PatchPoints, data: impl Fn(u32) -> VertexData) -> Contr
             }
         }
     }
-    let reflect = |a: VertexData, b: VertexData| -> VertexData {
-        let mut r = [0.0; 6];
-        for k in 0..6 {
-            r[k] = 2.0 * a[k] - b[k];
-        }
-        r
-    };
+    let reflect =
+        |a: VertexData, b: VertexData| -> VertexData { a.zip_with(&b, |a, b| 2.0 * a - b) };
     // Phantoms beside the face's sides first (from the face's own corners)...
     for m in 1..=2 {
         if !real[m][0] {
@@ -716,7 +704,7 @@ impl LocalPatch {
         self.reach(depth)?;
         let root = root as u32;
         let stride = n as i64 + 1;
-        let mut grid = vec![[0.0; 6]; (n + 1) * (n + 1)];
+        let mut grid = vec![VertexData::ZERO; (n + 1) * (n + 1)];
         for (d, (at, rows)) in self
             .depths
             .iter()
@@ -885,20 +873,22 @@ mod tests {
         (0..nv)
             .map(|k| {
                 let x = k as f64;
-                [
+                VertexData::from_array([
                     x * 1.3 + (x * 0.7).sin() * 2.0,
                     (x * 1.9).cos() * 3.0 + x * 0.2,
                     50.0 + 10.0 * (x * 0.37).sin(),
                     x * x * 0.01,
                     -(x * 0.11).cos(),
                     0.5 + 0.4 * (x * 0.5).sin(),
-                ]
+                ])
             })
             .collect()
     }
 
     fn close(a: VertexData, b: VertexData) -> bool {
-        (0..6).all(|k| (a[k] - b[k]).abs() < 1e-9 * (1.0 + a[k].abs()))
+        (0..6).all(|k| {
+            (a.to_array()[k] - b.to_array()[k]).abs() < 1e-9 * (1.0 + a.to_array()[k].abs())
+        })
     }
 
     /// The patch of face `f` at its corners equals the limit stencils; at its centre and side
@@ -1008,7 +998,7 @@ mod tests {
         }
         let lim = limit::limit_stencils(&level).unwrap().apply(&data);
         let stride = n as i64 + 1;
-        let mut grid = vec![[f64::NAN; 6]; (n + 1) * (n + 1)];
+        let mut grid = vec![VertexData::from_array([f64::NAN; 6]); (n + 1) * (n + 1)];
         for tile in &tiles {
             let fv = level.topology.face_vertices(tile.face as usize);
             let o = tile.origin;

@@ -69,20 +69,20 @@ fn check_condition_1(mesh: &GradientMesh, depth: usize) -> Result<(), TestCaseEr
             let got = data.levels[k][r.vertex_at_level(v as u32, k)];
             for c in 2..6 {
                 prop_assert!(
-                    (got[c] - d[c]).abs() < 1e-9,
+                    (got.to_array()[c] - d.to_array()[c]).abs() < 1e-9,
                     "vertex {v} level {k} channel {c}: {} vs {}",
-                    got[c],
-                    d[c]
+                    got.to_array()[c],
+                    d.to_array()[c]
                 );
             }
         }
         let got = limit[r.vertex_at_level(v as u32, depth)];
         for c in 2..6 {
             prop_assert!(
-                (got[c] - d[c]).abs() < 1e-9,
+                (got.to_array()[c] - d.to_array()[c]).abs() < 1e-9,
                 "vertex {v} limit channel {c}: {} vs {}",
-                got[c],
-                d[c]
+                got.to_array()[c],
+                d.to_array()[c]
             );
         }
     }
@@ -97,7 +97,7 @@ fn check_condition_2(mesh: &GradientMesh, depth: usize) -> Result<(), TestCaseEr
     for (k, level) in data.levels.iter().chain([&limit]).enumerate() {
         for d in level {
             for c in 0..4 {
-                let x = d[2 + c];
+                let x = d.to_array()[2 + c];
                 prop_assert!(
                     x >= lo[c] - 1e-9 && x <= hi[c] + 1e-9,
                     "level {k} channel {c}: {x} outside {}..{}",
@@ -118,8 +118,8 @@ fn check_rings(mesh: &GradientMesh) -> Result<(), TestCaseError> {
         for &f in t1.vertex_faces(v) {
             for &u in t1.face_vertices(f as usize) {
                 prop_assert_eq!(
-                    &data.levels[1][u as usize][2..],
-                    &base.data[v][2..],
+                    &data.levels[1][u as usize].to_array()[2..],
+                    &base.data[v].to_array()[2..],
                     "point {} of the ring of {}",
                     u,
                     v
@@ -156,7 +156,7 @@ fn interpolation_error(mesh: &GradientMesh, depth: usize) -> f64 {
         .enumerate()
         .map(|(p, point)| {
             let l = limit[r.vertex_at_level(p as u32, depth)];
-            (l[0] - point.position.x).hypot(l[1] - point.position.y) / scale
+            (l.position[0] - point.position.x).hypot(l.position[1] - point.position.y) / scale
         })
         .fold(0.0, f64::max)
 }
@@ -249,14 +249,14 @@ proptest! {
         let mut mesh = binary(build(&spec));
         let plain: Vec<_> = refine(&mesh, 3).1.levels[3]
             .iter()
-            .map(|d| [d[2], d[3], d[4], d[5]])
+            .map(|d| d.attributes())
             .collect();
         mesh.interpolate_positions = true;
         let e = interpolation_error(&mesh, 3);
         prop_assert!(e < 1e-9, "{e}");
         let colours: Vec<_> = refine(&mesh, 3).1.levels[3]
             .iter()
-            .map(|d| [d[2], d[3], d[4], d[5]])
+            .map(|d| d.attributes())
             .collect();
         prop_assert_eq!(colours, plain);
     }
@@ -331,7 +331,7 @@ fn default_handles_split_a_grid_regularly() {
     let (r, data) = refine(&mesh, 1);
     let t0 = r.topology(0);
     let d = &data.levels[1];
-    let at = |i: u32| Point::new(d[i as usize][0], d[i as usize][1]);
+    let at = |i: u32| Point::new(d[i as usize].position[0], d[i as usize].position[1]);
     let close = |i: u32, p: Point| {
         assert!((at(i) - p).hypot() < 1e-12, "{i}: {:?} vs {p:?}", at(i));
     };
@@ -394,7 +394,7 @@ fn the_quarter_points_lie_on_the_handles() {
         .unwrap() as u32;
     let end0 = usize::from(t0.edge_vertices(e as usize)[0] != 0);
     let d = &data.levels[1];
-    let p = |i: u32| Point::new(d[i as usize][0], d[i as usize][1]);
+    let p = |i: u32| Point::new(d[i as usize].position[0], d[i as usize].position[1]);
     let (v0, v1) = (Point::new(0.0, 0.0), Point::new(12.0, 0.0));
     assert!((p(edge_point(t0, e, end0)) - (v0 + h0 * HANDLE_SCALE)).hypot() < 1e-12);
     assert!((p(edge_point(t0, e, 1 - end0)) - (v1 + h1 * HANDLE_SCALE)).hypot() < 1e-12);
@@ -483,16 +483,16 @@ impl ColourField {
             Point::new(f64::MIN, f64::MIN),
         );
         for p in &limit {
-            lo = Point::new(lo.x.min(p[0]), lo.y.min(p[1]));
-            hi = Point::new(hi.x.max(p[0]), hi.y.max(p[1]));
+            lo = Point::new(lo.x.min(p.position[0]), lo.y.min(p.position[1]));
+            hi = Point::new(hi.x.max(p.position[0]), hi.y.max(p.position[1]));
         }
         let cell = ((hi.x - lo.x).max(hi.y - lo.y) / (triangles.len() as f64).sqrt()).max(1e-9);
         let columns = ((hi.x - lo.x) / cell) as usize + 1;
         let rows = ((hi.y - lo.y) / cell) as usize + 1;
         let mut buckets = vec![Vec::new(); columns * rows];
         for (i, tri) in triangles.iter().enumerate() {
-            let x = tri.map(|p| ((p[0] - lo.x) / cell) as usize);
-            let y = tri.map(|p| ((p[1] - lo.y) / cell) as usize);
+            let x = tri.map(|p| ((p.position[0] - lo.x) / cell) as usize);
+            let y = tri.map(|p| ((p.position[1] - lo.y) / cell) as usize);
             for row in *y.iter().min().unwrap()..=(*y.iter().max().unwrap()).min(rows - 1) {
                 for col in *x.iter().min().unwrap()..=(*x.iter().max().unwrap()).min(columns - 1) {
                     buckets[row * columns + col].push(i as u32);
@@ -518,15 +518,23 @@ impl ColourField {
         }
         for &i in &self.buckets[row as usize * self.columns + col as usize] {
             let [a, b, c] = &self.triangles[i as usize];
-            let det = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
+            let det = (b.position[0] - a.position[0]) * (c.position[1] - a.position[1])
+                - (c.position[0] - a.position[0]) * (b.position[1] - a.position[1]);
             if det == 0.0 {
                 continue;
             }
-            let u = ((p.x - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (p.y - a[1])) / det;
-            let v = ((b[0] - a[0]) * (p.y - a[1]) - (p.x - a[0]) * (b[1] - a[1])) / det;
+            let u = ((p.x - a.position[0]) * (c.position[1] - a.position[1])
+                - (c.position[0] - a.position[0]) * (p.y - a.position[1]))
+                / det;
+            let v = ((b.position[0] - a.position[0]) * (p.y - a.position[1])
+                - (p.x - a.position[0]) * (b.position[1] - a.position[1]))
+                / det;
             if u >= 0.0 && v >= 0.0 && u + v <= 1.0 {
                 let w = 1.0 - u - v;
-                return Some([2, 3, 4].map(|k| w * a[k] + u * b[k] + v * c[k]));
+                return Some(
+                    [2, 3, 4]
+                        .map(|k| w * a.to_array()[k] + u * b.to_array()[k] + v * c.to_array()[k]),
+                );
             }
         }
         None

@@ -58,7 +58,7 @@ fn default_handles_give_the_uniform_three_way_split() {
     let level1 = &data.levels[1];
     let mut seen = std::collections::HashSet::new();
     for d in level1 {
-        let (x, y) = (d[0], d[1]);
+        let (x, y) = (d.position[0], d.position[1]);
         assert!(
             (x - x.round()).abs() < 1e-12 && (y - y.round()).abs() < 1e-12,
             "{d:?}"
@@ -86,13 +86,16 @@ fn regular_grid_limit_is_the_uniform_bicubic_bspline_of_level_1() {
     let n1 = (3 * w + 1) as usize;
     let mut net = vec![[0.0f64; 3]; n1 * n1];
     for d in &data.levels[1] {
-        let (i, j) = (d[0].round() as usize, d[1].round() as usize);
-        net[j * n1 + i] = [d[2], d[3], d[4]];
+        let (i, j) = (
+            d.position[0].round() as usize,
+            d.position[1].round() as usize,
+        );
+        net[j * n1 + i] = d.colour;
     }
     let limit = r.limit(&data, depth);
     let mut checked = 0;
     for d in &limit {
-        let (u, v) = (d[0], d[1]);
+        let (u, v) = (d.position[0], d.position[1]);
         // Stay two lattice units inside, where no boundary rule reaches.
         if u < 2.0 || v < 2.0 || u > (n1 - 3) as f64 || v > (n1 - 3) as f64 {
             continue;
@@ -110,9 +113,9 @@ fn regular_grid_limit_is_the_uniform_bicubic_bspline_of_level_1() {
         }
         for k in 0..3 {
             assert!(
-                (d[2 + k] - expect[k]).abs() < 1e-9,
+                (d.to_array()[2 + k] - expect[k]).abs() < 1e-9,
                 "at ({u}, {v}) channel {k}: {} vs {}",
-                d[2 + k],
+                d.to_array()[2 + k],
                 expect[k]
             );
         }
@@ -173,7 +176,10 @@ fn a_crease_is_the_cubic_bspline_curve_of_its_refined_points() {
     // boundary, where three sharp edges make a corner): midpoints, and (1, 6, 1) / 8.
     let poly1 = crease_polygon(r.topology(1), &r.level(1).edge_sharpness);
     assert_eq!(poly1.len(), 13);
-    let mut curve: Vec<[f64; 6]> = poly1.iter().map(|&v| data.levels[1][v as usize]).collect();
+    let mut curve: Vec<[f64; 6]> = poly1
+        .iter()
+        .map(|&v| data.levels[1][v as usize].to_array())
+        .collect();
     let mix = |a: &[f64; 6], b: &[f64; 6], c: &[f64; 6], w: [f64; 3]| {
         std::array::from_fn(|k| w[0] * a[k] + w[1] * b[k] + w[2] * c[k])
     };
@@ -202,7 +208,7 @@ fn a_crease_is_the_cubic_bspline_curve_of_its_refined_points() {
             let ours = data.levels[level][v as usize];
             for c in 0..6 {
                 assert!(
-                    (ours[c] - curve[k][c]).abs() < 1e-9,
+                    (ours.to_array()[c] - curve[k][c]).abs() < 1e-9,
                     "level {level} point {k}"
                 );
             }
@@ -219,7 +225,7 @@ fn a_crease_is_the_cubic_bspline_curve_of_its_refined_points() {
         );
         let got = limit[poly[i] as usize];
         for c in 0..6 {
-            assert!((got[c] - expect[c]).abs() < 1e-9);
+            assert!((got.to_array()[c] - expect[c]).abs() < 1e-9);
         }
     }
 }

@@ -34,7 +34,7 @@ fn run(path: &Path) -> Result<(), Error> {
         let limit = r.limit(&data, 3);
         for (v, d) in limit.iter().enumerate() {
             assert!(
-                d.iter().all(|x| x.is_finite()),
+                d.to_array().iter().all(|x| x.is_finite()),
                 "layer {i} vertex {v}: {d:?}"
             );
         }

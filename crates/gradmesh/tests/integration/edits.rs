@@ -74,7 +74,7 @@ fn sparse() -> GradientMesh {
 }
 
 fn colour_of(d: &VertexData) -> [f64; 3] {
-    [d[2], d[3], d[4]]
+    d.colour
 }
 
 fn set_colour(level: u32, face: u32, point: u32, at: [u32; 2], c: [f64; 3]) -> Edit {
@@ -115,10 +115,11 @@ fn addresses_name_the_vertices_the_format_documents() {
                         let d = data.levels[level as usize][v];
                         let want = here + next * (step * i as f64) + prev * (step * j as f64);
                         assert!(
-                            (d[0] - want.x).abs() < 1e-9 && (d[1] - want.y).abs() < 1e-9,
+                            (d.position[0] - want.x).abs() < 1e-9
+                                && (d.position[1] - want.y).abs() < 1e-9,
                             "{a}: vertex {v} at ({}, {}), expected {want:?}",
-                            d[0],
-                            d[1]
+                            d.position[0],
+                            d.position[1]
                         );
                     }
                 }
@@ -264,7 +265,11 @@ fn colours_stay_in_the_hull_of_the_colours_in_play() {
             t >= lo - 1e-9 && t <= hi + 1e-9,
             "t = {t} outside [{lo}, {hi}]"
         );
-        assert!((-1e-12..=1.0 + 1e-12).contains(&d[5]), "opacity {}", d[5]);
+        assert!(
+            (-1e-12..=1.0 + 1e-12).contains(&d.opacity),
+            "opacity {}",
+            d.opacity
+        );
     }
 }
 
@@ -323,10 +328,10 @@ fn an_edit_changes_the_picture_only_inside_its_support() {
         for &x in &verts {
             let d = data.levels[2][x as usize];
             bounds = [
-                bounds[0].min(d[0]),
-                bounds[1].min(d[1]),
-                bounds[2].max(d[0]),
-                bounds[3].max(d[1]),
+                bounds[0].min(d.position[0]),
+                bounds[1].min(d.position[1]),
+                bounds[2].max(d.position[0]),
+                bounds[3].max(d.position[1]),
             ];
         }
     }
@@ -401,17 +406,19 @@ fn fine_edits_follow_coarse_edits() {
         let (v, d) = where_(&mut r, &data, i);
         let (v2, d2) = where_(&mut r2, &data2, i);
         assert_eq!(v, v2, "edit {i} stays on its vertex");
-        let want = map(Point::new(d[0], d[1]));
+        let want = map(d.point());
         assert!(
-            (d2[0] - want.x).abs() < 1e-9 && (d2[1] - want.y).abs() < 1e-9,
+            (d2.position[0] - want.x).abs() < 1e-9 && (d2.position[1] - want.y).abs() < 1e-9,
             "edit {i}: ({}, {}) should be {want:?}",
-            d2[0],
-            d2[1]
+            d2.position[0],
+            d2.position[1]
         );
         match edited.edits[i].colour {
             // A relative edit follows the recolouring; an absolute one stays.
-            Some(ColourEdit::Offset(_)) => assert!((d2[2] - d[2] - 10.0).abs() < 1e-9),
-            Some(ColourEdit::Set(c)) => assert!((d2[2] - c[0]).abs() < 1e-12),
+            Some(ColourEdit::Offset(_)) => {
+                assert!((d2.colour[0] - d.colour[0] - 10.0).abs() < 1e-9)
+            }
+            Some(ColourEdit::Set(c)) => assert!((d2.colour[0] - c[0]).abs() < 1e-12),
             None => {}
         }
     }
@@ -419,8 +426,12 @@ fn fine_edits_follow_coarse_edits() {
     let (plain, _) = Refinement::new(&mesh, 3).unwrap();
     let p = plain.evaluate();
     let (v, d) = where_(&mut r, &data, 0);
-    assert!((p.levels[2][v][0] - d[0]).abs() + (p.levels[2][v][1] - d[1]).abs() > 1.0);
-    assert!((p.levels[2][v][2] - 20.0 - d[2]).abs() < 1e-9);
+    assert!(
+        (p.levels[2][v].position[0] - d.position[0]).abs()
+            + (p.levels[2][v].position[1] - d.position[1]).abs()
+            > 1.0
+    );
+    assert!((p.levels[2][v].colour[0] - 20.0 - d.colour[0]).abs() < 1e-9);
 }
 
 #[test]
@@ -641,12 +652,12 @@ proptest! {
         let mut all: Vec<VertexData> = data.levels.concat();
         all.extend(r.limit(&data, 4));
         for d in &all {
-            prop_assert!(d.iter().all(|x| x.is_finite()), "{:?}", d);
-            prop_assert!((-1e-12..=1.0 + 1e-12).contains(&d[5]), "opacity {}", d[5]);
+            prop_assert!(d.to_array().iter().all(|x| x.is_finite()), "{:?}", d);
+            prop_assert!((-1e-12..=1.0 + 1e-12).contains(&d.opacity), "opacity {}", d.opacity);
             for k in 0..3 {
                 let slack = 1e-9 * (1.0 + hi[k].abs().max(lo[k].abs()));
-                prop_assert!(d[2 + k] >= lo[k] - slack && d[2 + k] <= hi[k] + slack,
-                    "channel {} = {} outside [{}, {}]", k, d[2 + k], lo[k], hi[k]);
+                prop_assert!(d.to_array()[2 + k] >= lo[k] - slack && d.to_array()[2 + k] <= hi[k] + slack,
+                    "channel {} = {} outside [{}, {}]", k, d.to_array()[2 + k], lo[k], hi[k]);
             }
         }
     }
@@ -677,14 +688,18 @@ fn a_move_on_a_discontinuous_edge_moves_both_sides() {
     let (a, b) = (r.edited_vertex(0).unwrap(), r.edited_vertex(1).unwrap());
     assert_ne!(a, b);
     let (da, db) = (data.levels[2][a], data.levels[2][b]);
-    assert_eq!([da[0], da[1]], [db[0], db[1]], "both sides at one place");
+    assert_eq!(
+        [da.position[0], da.position[1]],
+        [db.position[0], db.position[1]],
+        "both sides at one place"
+    );
     let (plain, _) = Refinement::new(&mesh, 3).unwrap();
     let p = plain.evaluate().levels[2][a];
     assert!(
-        (p[0] - da[0]).abs() + (p[1] - da[1]).abs() > 1.0,
+        (p.position[0] - da.position[0]).abs() + (p.position[1] - da.position[1]).abs() > 1.0,
         "it moved"
     );
     // Colour is per side: the other side keeps its own.
-    assert!((da[3] - p[3] - 30.0).abs() < 1e-9);
-    assert!((db[3] - plain.evaluate().levels[2][b][3]).abs() < 1e-12);
+    assert!((da.colour[1] - p.colour[1] - 30.0).abs() < 1e-9);
+    assert!((db.colour[1] - plain.evaluate().levels[2][b].colour[1]).abs() < 1e-12);
 }

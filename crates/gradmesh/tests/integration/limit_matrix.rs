@@ -8,7 +8,7 @@ use std::path::Path;
 use gradmesh::formats::read_path;
 use gradmesh::{
     limit_matrix, refine_level, Edit, ErrorKind, FirstStep, GradientMesh, LevelPoints, LimitMatrix,
-    Limits, Refinement, VertexAddress,
+    Limits, Refinement, VertexAddress, VertexData,
 };
 use proptest::prelude::*;
 
@@ -21,18 +21,18 @@ fn control_values(mesh: &GradientMesh) -> Vec<f64> {
 }
 
 /// Asserts that `matrix` applied to `control` gives the colour and opacity of `limit`.
-fn assert_maps_to(matrix: &LimitMatrix, control: &[f64], limit: &[[f64; 6]], what: &str) {
+fn assert_maps_to(matrix: &LimitMatrix, control: &[f64], limit: &[VertexData], what: &str) {
     assert_eq!(matrix.rows, limit.len(), "{what}: one row per vertex");
     assert_eq!(matrix.offsets.len(), matrix.rows + 1, "{what}");
     let mapped = matrix.apply(control, 4);
     for (v, (got, want)) in mapped.chunks_exact(4).zip(limit).enumerate() {
         for c in 0..4 {
-            let err = (got[c] - want[2 + c]).abs();
+            let err = (got[c] - want.attributes()[c]).abs();
             assert!(
                 err <= 1e-12,
                 "{what}: vertex {v} channel {c}: matrix gives {}, refinement {} (error {err:e})",
                 got[c],
-                want[2 + c]
+                want.attributes()[c]
             );
         }
     }
@@ -55,7 +55,7 @@ fn check_by_split_vertex(mesh: &GradientMesh, level: usize, what: &str) {
     let matrix = refinement.limit_matrix(level).expect(&what);
     let base = refinement.base().data.clone();
     assert_eq!(matrix.columns, base.len(), "{what}");
-    let control: Vec<f64> = base.iter().flat_map(|d| [d[2], d[3], d[4], d[5]]).collect();
+    let control: Vec<f64> = base.iter().flat_map(|d| d.attributes()).collect();
     let data = refinement.evaluate();
     let limit = refinement.limit(&data, level);
     assert_maps_to(&matrix, &control, &limit, &what);

@@ -71,7 +71,7 @@ fn oracle(mesh: &GradientMesh) -> (Vec<Vec<VertexData>>, Vec<VertexData>) {
     .expect("valid topology");
     refiner.refine_uniform(UniformOptions::new(DEPTH));
     let primvars = PrimvarRefiner::new(&refiner);
-    let base: Vec<VertexData> = mesh
+    let base: Vec<[f64; 6]> = mesh
         .points
         .iter()
         .map(|p| {
@@ -93,7 +93,8 @@ fn oracle(mesh: &GradientMesh) -> (Vec<Vec<VertexData>>, Vec<VertexData>) {
     }
     let mut limit = vec![[0.0; 6]; data[DEPTH].len()];
     primvars.limit(&data[DEPTH], &mut limit);
-    (data, limit)
+    let structs = |l: Vec<[f64; 6]>| l.into_iter().map(VertexData::from_array).collect();
+    (data.into_iter().map(structs).collect(), structs(limit))
 }
 
 /// Checks that every vertex of `a` has a vertex of `b` at the same position with the same
@@ -101,15 +102,18 @@ fn oracle(mesh: &GradientMesh) -> (Vec<Vec<VertexData>>, Vec<VertexData>) {
 fn same_points(a: &[VertexData], b: &[VertexData], what: &str) -> Result<(), TestCaseError> {
     prop_assert!(a.len() <= b.len(), "{}: vertex count", what);
     let mut order: Vec<usize> = (0..b.len()).collect();
-    order.sort_by(|&i, &j| b[i][0].total_cmp(&b[j][0]));
-    let xs: Vec<f64> = order.iter().map(|&i| b[i][0]).collect();
+    order.sort_by(|&i, &j| b[i].position[0].total_cmp(&b[j].position[0]));
+    let xs: Vec<f64> = order.iter().map(|&i| b[i].position[0]).collect();
     let tol = |x: f64| 1e-5 * x.abs().max(100.0);
     for p in a {
-        let start = xs.partition_point(|&x| x < p[0] - tol(p[0]));
+        let start = xs.partition_point(|&x| x < p.position[0] - tol(p.position[0]));
         let found = order[start..]
             .iter()
-            .take_while(|&&i| b[i][0] <= p[0] + tol(p[0]))
-            .any(|&i| (0..6).all(|c| (b[i][c] - p[c]).abs() <= tol(p[c])));
+            .take_while(|&&i| b[i].position[0] <= p.position[0] + tol(p.position[0]))
+            .any(|&i| {
+                let (q, p) = (b[i].to_array(), p.to_array());
+                (0..6).all(|c| (q[c] - p[c]).abs() <= tol(p[c]))
+            });
         prop_assert!(found, "{}: no match for {:?}", what, p);
     }
     Ok(())

@@ -22,7 +22,7 @@ fn interpolation_error(mesh: &GradientMesh, depth: usize) -> f64 {
         .enumerate()
         .map(|(p, point)| {
             let l = limit[r.vertex_at_level(p as u32, depth)];
-            (l[0] - point.position.x).hypot(l[1] - point.position.y) / scale
+            (l.position[0] - point.position.x).hypot(l.position[1] - point.position.y) / scale
         })
         .fold(0.0, f64::max)
 }
@@ -93,13 +93,13 @@ proptest! {
         let mut mesh = build(&spec);
         let plain_colours: Vec<_> = {
             let (r, _) = Refinement::new(&mesh, 3).unwrap();
-            r.evaluate().levels[3].iter().map(|d| [d[2], d[3], d[4], d[5]]).collect()
+            r.evaluate().levels[3].iter().map(|d| [d.colour[0], d.colour[1], d.colour[2], d.opacity]).collect()
         };
         mesh.interpolate_positions = true;
         let e = interpolation_error(&mesh, 3);
         prop_assert!(e < 1e-9);
         let (r, _) = Refinement::new(&mesh, 3).unwrap();
-        let colours: Vec<_> = r.evaluate().levels[3].iter().map(|d| [d[2], d[3], d[4], d[5]]).collect();
+        let colours: Vec<_> = r.evaluate().levels[3].iter().map(|d| [d.colour[0], d.colour[1], d.colour[2], d.opacity]).collect();
         prop_assert_eq!(colours, plain_colours);
     }
 }

@@ -46,16 +46,16 @@ proptest! {
             let chain = vertex_chain(&r, p as u32, depth);
             for (k, &v) in chain.iter().enumerate() {
                 for c in 0..3 {
-                    let got = data.levels[k][v][2 + c];
+                    let got = data.levels[k][v].to_array()[2 + c];
                     prop_assert!((got - point.colour[c]).abs() < 1e-9,
                         "point {p} level {k} channel {c}: {got} vs {}", point.colour[c]);
                 }
             }
             let v = chain[depth];
             for c in 0..3 {
-                prop_assert!((limit[v][2 + c] - point.colour[c]).abs() < 1e-9);
+                prop_assert!((limit[v].to_array()[2 + c] - point.colour[c]).abs() < 1e-9);
             }
-            prop_assert!((limit[v][5] - point.opacity).abs() < 1e-9);
+            prop_assert!((limit[v].opacity - point.opacity).abs() < 1e-9);
         }
     }
 
@@ -70,7 +70,7 @@ proptest! {
         for (k, level) in data.levels.iter().chain(std::iter::once(&limit)).enumerate() {
             for d in level {
                 for c in 0..4 {
-                    let x = d[2 + c];
+                    let x = d.to_array()[2 + c];
                     prop_assert!(x >= lo[c] - 1e-9 && x <= hi[c] + 1e-9,
                         "level {k} channel {c}: {x} outside {}..{}", lo[c], hi[c]);
                 }
@@ -105,8 +105,8 @@ proptest! {
             let (_, d1) = refine(&moved, 3);
             for k in 0..=3 {
                 for (p, q) in d0.levels[k].iter().zip(&d1.levels[k]) {
-                    let expect = a * Point::new(p[0], p[1]);
-                    let err = (expect - Point::new(q[0], q[1])).hypot();
+                    let expect = a * Point::new(p.position[0], p.position[1]);
+                    let err = (expect - Point::new(q.position[0], q.position[1])).hypot();
                     prop_assert!(err < 1e-7 * (1.0 + expect.to_vec2().hypot()),
                         "level {k}: {expect:?} vs {q:?}");
                 }

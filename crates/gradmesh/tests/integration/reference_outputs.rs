@@ -68,8 +68,8 @@ fn close(ours: f64, printed: f64) -> bool {
 fn match_by_position(ours: &[VertexData], reference: &Reference) -> Vec<Option<usize>> {
     // Sort our vertices by x to search a narrow window.
     let mut order: Vec<usize> = (0..ours.len()).collect();
-    order.sort_by(|&a, &b| ours[a][0].total_cmp(&ours[b][0]));
-    let xs: Vec<f64> = order.iter().map(|&i| ours[i][0]).collect();
+    order.sort_by(|&a, &b| ours[a].position[0].total_cmp(&ours[b].position[0]));
+    let xs: Vec<f64> = order.iter().map(|&i| ours[i].position[0]).collect();
     reference
         .points
         .iter()
@@ -78,15 +78,15 @@ fn match_by_position(ours: &[VertexData], reference: &Reference) -> Vec<Option<u
             let start = xs.partition_point(|&x| x < p[0] - tol);
             let candidates: Vec<usize> = order[start..]
                 .iter()
-                .take_while(|&&i| ours[i][0] <= p[0] + tol)
+                .take_while(|&&i| ours[i].position[0] <= p[0] + tol)
                 .copied()
-                .filter(|&i| close(ours[i][1], p[1]))
+                .filter(|&i| close(ours[i].position[1], p[1]))
                 .collect();
             // Prefer a candidate whose colour matches too (split points share positions).
             candidates
                 .iter()
                 .copied()
-                .find(|&i| (0..3).all(|c| close(ours[i][2 + c], p[2 + c])))
+                .find(|&i| (0..3).all(|c| close(ours[i].colour[c], p[2 + c])))
                 .or(candidates.first().copied())
         })
         .collect()
@@ -108,8 +108,9 @@ fn compare(topology: &Topology, ours: &[VertexData], reference: &Reference) -> C
         .collect();
     let colour_mismatch = (0..matched.len())
         .filter(|&i| {
-            matched[i]
-                .is_some_and(|j| !(0..3).all(|c| close(ours[j][2 + c], reference.points[i][2 + c])))
+            matched[i].is_some_and(|j| {
+                !(0..3).all(|c| close(ours[j].to_array()[2 + c], reference.points[i][2 + c]))
+            })
         })
         .collect();
     let mut our_faces = std::collections::HashSet::new();

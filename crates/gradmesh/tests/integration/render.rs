@@ -174,7 +174,10 @@ fn limit_points(mesh: &GradientMesh) -> Vec<(Point, [f64; 3])> {
     (0..mesh.points.len() as u32)
         .map(|v| {
             let d = lim[r.vertex_at_level(v, 2)];
-            (Point::new(d[0], d[1]), mesh.points[v as usize].colour)
+            (
+                Point::new(d.position[0], d.position[1]),
+                mesh.points[v as usize].colour,
+            )
         })
         .collect()
 }

@@ -17,7 +17,7 @@ fn run(mesh: &GradientMesh, depth: usize) -> (Vec<Vec<[u64; 6]>>, String) {
     let bits = data
         .levels
         .iter()
-        .map(|l| l.iter().map(|d| d.map(f64::to_bits)).collect())
+        .map(|l| l.iter().map(|d| d.to_array().map(f64::to_bits)).collect())
         .collect();
     let obj = obj::write_refined_obj(&[(None, r.topology(depth), &data.levels[depth])]);
     (bits, obj)
@@ -98,7 +98,11 @@ fn refine_data_equals_applying_the_stencils() {
     let (r, _) = Refinement::new(&mesh, 3).unwrap();
     let data = r.evaluate();
     for k in 1..3 {
-        let bits = |d: &[VertexData]| d.iter().map(|x| x.map(f64::to_bits)).collect::<Vec<_>>();
+        let bits = |d: &[VertexData]| {
+            d.iter()
+                .map(|x| x.to_array().map(f64::to_bits))
+                .collect::<Vec<_>>()
+        };
         let direct = in_pool(1, || {
             catmull_clark::refine_data(r.level(k), &data.levels[k])
         });

@@ -61,7 +61,7 @@ pub fn draw_outlines(doc: &Document, opts: &RenderOptions, image: &mut Image) ->
         let data = refinement.evaluate();
         let px: Vec<[f64; 2]> = data.levels[2]
             .iter()
-            .map(|d| xf.apply(d[0], d[1]))
+            .map(|d| xf.apply(d.position[0], d.position[1]))
             .collect();
         let loops = boundary_loops(refinement.topology(2));
         for l in outline(refinement.level(2), &loops, &px, 0.02) {

@@ -91,7 +91,7 @@ impl FaceSurface {
     ) -> bool {
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         let mut grow = |d: &VertexData| {
-            let p = xf.apply(d[0], d[1]);
+            let p = xf.apply(d.position[0], d.position[1]);
             for k in 0..2 {
                 lo[k] = lo[k].min(p[k]);
                 hi[k] = hi[k].max(p[k]);
@@ -212,7 +212,7 @@ fn measure_grid(
     let jacobians = needs_jacobians(th.space).then(|| {
         jacobians.extend(g2.iter().enumerate().map(|(k, d)| {
             if (k % s2) % 2 == 1 && (k / s2) % 2 == 1 {
-                th.space.lab_jacobian([d[2], d[3], d[4]])
+                th.space.lab_jacobian(d.colour)
             } else {
                 Matrix3::default()
             }
@@ -910,7 +910,7 @@ fn turn_flags(g: &[VertexData], step: usize, n: usize) -> u8 {
         for i in 0..n {
             let [a, b, c, d] = each4(|k| {
                 let (x, y) = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)][k];
-                &g[y * s + x * step]
+                g[y * s + x * step].position
             });
             // Twice the signed area of the quad: the cross product of its diagonals.
             let cross = (c[0] - a[0]) * (d[1] - b[1]) - (c[1] - a[1]) * (d[0] - b[0]);

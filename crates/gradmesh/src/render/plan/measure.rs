@@ -238,8 +238,8 @@ pub(crate) fn measure_quad(
     min_quad: f64,
     adaptive: bool,
 ) -> Measure {
-    let px = |d: &VertexData| xf.apply(d[0], d[1]);
-    let attr = |d: &VertexData| [d[2], d[3], d[4], d[5]];
+    let px = |d: &VertexData| xf.apply(d.position[0], d.position[1]);
+    let attr = |d: &VertexData| d.attributes();
     let dist = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
     let mut m = Measure::default();
     let p = each4(|k| px(q.corners[k]));

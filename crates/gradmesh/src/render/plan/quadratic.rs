@@ -105,9 +105,10 @@ pub(crate) fn chord_node(
     grad: &Gradient,
     xf: &ToPixels,
 ) -> [f64; 4] {
-    let at = xf.apply(mid[0], mid[1]);
+    let at = xf.apply(mid.position[0], mid.position[1]);
     let (ox, oy) = (0.5 * (a[0] + b[0]) - at[0], 0.5 * (a[1] + b[1]) - at[1]);
-    each4(|k| mid[2 + k] + grad[k][0] * ox + grad[k][1] * oy)
+    let attr = mid.attributes();
+    each4(|k| attr[k] + grad[k][0] * ox + grad[k][1] * oy)
 }
 
 /// The screen gradient of the attributes at point `(i, j)` of a face's grid `g` of `side`
@@ -131,24 +132,23 @@ pub(crate) fn screen_gradient(
         }
     };
     let ((pi, wi), (pj, wj)) = (stencil(i), stencil(j));
-    let (mut di, mut dj) = ([0.0; 6], [0.0; 6]);
+    let (mut di, mut dj) = (VertexData::ZERO, VertexData::ZERO);
     for n in 0..3 {
-        let (a, b) = (&g[j * side + pi[n]], &g[pj[n] * side + i]);
-        for k in 0..6 {
-            di[k] += wi[n] * a[k];
-            dj[k] += wj[n] * b[k];
-        }
+        di.add_scaled(&g[j * side + pi[n]], wi[n]);
+        dj.add_scaled(&g[pj[n] * side + i], wj[n]);
     }
     // The map to pixels is a scaling (and a shift, which differences drop).
-    let (a, b, c, d) = (di[0] * xf.sx, di[1] * xf.sy, dj[0] * xf.sx, dj[1] * xf.sy);
+    let (a, b) = (di.position[0] * xf.sx, di.position[1] * xf.sy);
+    let (c, d) = (dj.position[0] * xf.sx, dj.position[1] * xf.sy);
     // Solve [dx/di dy/di; dx/dj dy/dj] [gx; gy] = [dC/di; dC/dj].
     let det = a * d - b * c;
     let scale = (a * a + b * b).max(c * c + d * d);
     if !well_conditioned(det, scale) {
         return [[0.0; 2]; 4];
     }
+    let (di, dj) = (di.attributes(), dj.attributes());
     each4(|k| {
-        let (ci, cj) = (di[2 + k], dj[2 + k]);
+        let (ci, cj) = (di[k], dj[k]);
         [(ci * d - b * cj) / det, (a * cj - c * ci) / det]
     })
 }
@@ -179,8 +179,8 @@ pub(crate) fn measure_cells(
     let (s2, s4) = (2 * n + 1, 4 * n + 1);
     let at2 = |(i, j): (usize, usize)| &g2[j * s2 + i];
     let at4 = |i: usize, j: usize| &g4[j * s4 + i];
-    let px = |d: &VertexData| xf.apply(d[0], d[1]);
-    let attr = |d: &VertexData| [d[2], d[3], d[4], d[5]];
+    let px = |d: &VertexData| xf.apply(d.position[0], d.position[1]);
+    let attr = |d: &VertexData| d.attributes();
     let node_at = |a: (usize, usize), b: (usize, usize)| {
         let m = (a.0 + b.0, a.1 + b.1);
         let (pa, pb) = (at2((2 * a.0, 2 * a.1)), at2((2 * b.0, 2 * b.1)));
@@ -261,13 +261,13 @@ mod tests {
                 let (i, j) = ((k % side) as f64, (k / side) as f64);
                 let (x, y) = (2.0 * i + 0.5 * j, 2.0 * j);
                 let c = field(x, y);
-                [x, y, c[0], c[1], c[2], c[3]]
+                VertexData::from_array([x, y, c[0], c[1], c[2], c[3]])
             })
             .collect();
         for (i, j) in [(0, 0), (2, 1), (4, 4), (0, 3), (4, 2)] {
             let grad = screen_gradient(&g, side, (i, j), &xf);
             let d = &g[j * side + i];
-            let (x, y) = (d[0], d[1]);
+            let (x, y) = (d.position[0], d.position[1]);
             // Screen pixels per plane unit: 10.
             let want = [
                 [
@@ -285,13 +285,13 @@ mod tests {
             }
         }
         // A triangle of three grid points with its midpoints' nodes reproduces the field.
-        let px = |k: usize| xf.apply(g[k][0], g[k][1]);
+        let px = |k: usize| xf.apply(g[k].position[0], g[k].position[1]);
         let corners = [0, 2, 12];
         let mids = [(1, 0), (2, 1), (1, 1)];
         let m = side_nodes(&g, side, &xf, corners, mids);
         let q = Quadratic {
             p: corners.map(px),
-            c: corners.map(|k| [g[k][2], g[k][3], g[k][4], g[k][5]]),
+            c: corners.map(|k| g[k].attributes()),
             m,
         };
         for (x, y) in [(1.0, 0.5), (2.5, 1.5), (3.0, 0.25)] {
@@ -321,8 +321,8 @@ mod tests {
             let (a, b) = (corners[e], corners[(e + 1) % 3]);
             let (i, j) = mids[e];
             chord_node(
-                xf.apply(g[a][0], g[a][1]),
-                xf.apply(g[b][0], g[b][1]),
+                xf.apply(g[a].position[0], g[a].position[1]),
+                xf.apply(g[b].position[0], g[b].position[1]),
                 &g[j * side + i],
                 &screen_gradient(g, side, (i, j), xf),
                 xf,

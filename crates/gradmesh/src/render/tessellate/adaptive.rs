@@ -76,7 +76,7 @@ fn base_level(refinement: &Refinement, pixels: usize) -> usize {
 fn covered_pixels(points: &[VertexData], xf: &ToPixels, size: (i64, i64)) -> usize {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for d in points {
-        let p = xf.apply(d[0], d[1]);
+        let p = xf.apply(d.position[0], d.position[1]);
         for k in 0..2 {
             lo[k] = lo[k].min(p[k]);
             hi[k] = hi[k].max(p[k]);
@@ -231,7 +231,7 @@ fn faces_to_build(t: &Topology, kept: &[bool], now: &[usize], last: &[usize]) ->
 fn faces_to_plan_again(t: &Topology, old: &[VertexData], new: &[VertexData]) -> Vec<bool> {
     let mut again = vec![false; t.face_count()];
     let changed = |v: &usize| {
-        let (a, b) = (&old[*v], &new[*v]);
+        let (a, b) = (old[*v].to_array(), new[*v].to_array());
         a.iter().zip(b).any(|(x, y)| x.to_bits() != y.to_bits())
     };
     for v in (0..new.len()).filter(changed) {
@@ -528,7 +528,7 @@ mod tests {
     #[test]
     fn covered_pixels_are_the_points_box_clipped_to_the_image() {
         let xf = ToPixels::new(&View::new(0.0, 0.0, 100.0, 50.0), 100, 50);
-        let at = |x: f64, y: f64| [x, y, 50.0, 0.0, 0.0, 1.0];
+        let at = |x: f64, y: f64| VertexData::from_array([x, y, 50.0, 0.0, 0.0, 1.0]);
         let inside = [at(10.0, 5.0), at(30.0, 25.0), at(20.0, 10.0)];
         assert_eq!(covered_pixels(&inside, &xf, (100, 50)), 400);
         let across = [at(-10.0, -10.0), at(20.0, 10.0)];

@@ -13,7 +13,7 @@ use crate::mesh::GradientMesh;
 use crate::refine::{RefinedData, Refinement};
 use crate::size_limits::Limits;
 use crate::topology::Topology;
-use crate::validate::{attributes, BaseMesh, VertexData, COLOUR, X, Y};
+use crate::validate::{BaseMesh, VertexData};
 
 use super::adaptive;
 use super::clip::clip_lines;
@@ -458,8 +458,11 @@ fn uniform_triangles(
     xf: &ToPixels,
     size: (i64, i64),
 ) -> (TriangleList, Vec<Segment>) {
-    let exact: Vec<[f64; 2]> = lim.iter().map(|d| xf.apply(d[X], d[Y])).collect();
-    let attr = |v: u32| attributes(&lim[v as usize]);
+    let exact: Vec<[f64; 2]> = lim
+        .iter()
+        .map(|d| xf.apply(d.position[0], d.position[1]))
+        .collect();
+    let attr = |v: u32| lim[v as usize].attributes();
     let face_triangles = |f: usize| -> Vec<Triangle> {
         let fv = t.face_vertices(f);
         (1..fv.len() - 1)
@@ -558,7 +561,7 @@ pub(crate) fn prepare(
     let loops = boundary_loops(refinement.topology(k));
     let control_px: Vec<[f64; 2]> = data.levels[k]
         .iter()
-        .map(|d| xf.apply(d[X], d[Y]))
+        .map(|d| xf.apply(d.position[0], d.position[1]))
         .collect();
     let tolerance = if opts.reference {
         REFERENCE_OUTLINE_TOLERANCE_PX
@@ -578,7 +581,7 @@ pub(crate) fn prepare(
     }
     let colours_in_unit_range = data.levels[k]
         .iter()
-        .all(|d| d[COLOUR].iter().all(|c| (0.0..=1.0).contains(c)));
+        .all(|d| d.colour.iter().all(|c| (0.0..=1.0).contains(c)));
     let layer = DrawableLayer {
         space,
         triangles,

@@ -34,7 +34,8 @@ fn side_position(k: usize, s: usize, m: usize) -> (usize, usize) {
 /// The mean of two samples' attributes.
 #[inline]
 fn mean(a: &VertexData, b: &VertexData) -> [f64; 4] {
-    each4(|k| 0.5 * (a[2 + k] + b[2 + k]))
+    let (a, b) = (a.attributes(), b.attributes());
+    each4(|k| 0.5 * (a[k] + b[k]))
 }
 
 /// The bounds of the colours of the base level's points `data` (whose convex hull holds the
@@ -43,9 +44,10 @@ pub(crate) fn colour_bounds(plans: &[Arc<Plan>], data: &[VertexData]) -> Option<
     plans.iter().any(|p| p.order == Order::Quadratic).then(|| {
         let mut b = [[f32::INFINITY; 4], [f32::NEG_INFINITY; 4]];
         for p in data {
+            let attr = p.attributes();
             for k in 0..4 {
                 // Widened by a millionth: the f32 of a value may lie on either side of it.
-                let v = p[2 + k] as f32;
+                let v = attr[k] as f32;
                 let margin = 1e-6 * (1.0 + v.abs());
                 b[0][k] = b[0][k].min(v - margin);
                 b[1][k] = b[1][k].max(v + margin);
@@ -147,7 +149,7 @@ impl<'a> Stitching<'a> {
 
     #[inline]
     fn px(&self, d: &VertexData) -> [f64; 2] {
-        self.xf.apply(d[0], d[1])
+        self.xf.apply(d.position[0], d.position[1])
     }
 
     /// Sample `s` (`0..=ne`) of edge `e`, from its first vertex.
@@ -320,10 +322,13 @@ impl<'a> Stitching<'a> {
         }
         let xf = self.xf;
         for (w, node) in s.windows(2).zip(&nodes) {
-            let (pa, pb) = (xf.apply(w[0][0], w[0][1]), xf.apply(w[1][0], w[1][1]));
+            let (pa, pb) = (
+                xf.apply(w[0].position[0], w[0].position[1]),
+                xf.apply(w[1].position[0], w[1].position[1]),
+            );
             let snappable = |p: [f64; 2]| snap(p[0]).is_some() && snap(p[1]).is_some();
             if snappable(pa) && snappable(pb) {
-                let c = |d: &VertexData| [d[2], d[3], d[4], d[5]].map(|x| x as f32);
+                let c = |d: &VertexData| d.attributes().map(|x| x as f32);
                 segments.push(Segment {
                     a: pa,
                     b: pb,
@@ -372,7 +377,7 @@ fn vertex_samples(t: &Topology, plans: &[Arc<Plan>]) -> Vec<VertexData> {
             let (Some(&f), Some(&c)) =
                 (t.vertex_faces(v).first(), t.vertex_face_corners(v).first())
             else {
-                return [0.0; 6];
+                return VertexData::ZERO;
             };
             let m = plans[f as usize].n;
             let (i, j) = side_position(c as usize, 0, m);
@@ -554,7 +559,7 @@ impl<'s, 'a> FaceDrawing<'s, 'a> {
         let diagonal = self.own_node(g2, cell[0], cell[2]);
         let triangle = |v: [usize; 3], mids: [[f64; 4]; 3]| Quadratic {
             p: v.map(|k| px(q[k])),
-            c: v.map(|k| [q[k][2], q[k][3], q[k][4], q[k][5]]),
+            c: v.map(|k| q[k].attributes()),
             m: mids,
         };
         let halves = [
@@ -640,7 +645,7 @@ fn screen_triangle(
     xf: &ToPixels,
     size: (i64, i64),
 ) -> Option<Triangle> {
-    let exact = each3(|k| xf.apply(d[k][0], d[k][1]));
-    let attr = each3(|k| [d[k][2], d[k][3], d[k][4], d[k][5]]);
+    let exact = each3(|k| xf.apply(d[k].position[0], d[k].position[1]));
+    let attr = each3(|k| d[k].attributes());
     crate::render::raster::triangles::screen_triangle_px(exact, attr, mids, bounds, size)
 }

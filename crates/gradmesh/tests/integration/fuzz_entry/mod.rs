@@ -123,7 +123,7 @@ pub fn check_mesh(mesh: &GradientMesh, depth: usize) {
         }
         let at = refinement.vertex_at_level(v as u32, depth);
         for c in 2..6 {
-            let (want, got) = (base.data[v][c], limit[at][c]);
+            let (want, got) = (base.data[v].to_array()[c], limit[at].to_array()[c]);
             assert!(
                 (want - got).abs() <= 1e-9 * want.abs().max(1.0),
                 "Condition 1: vertex {v} channel {c}: limit {got}, control value {want}"
@@ -144,10 +144,10 @@ fn points_next_to_edits(mesh: &GradientMesh) -> std::collections::HashSet<u32> {
 }
 
 /// Asserts that the data of every vertex of `topology` is finite.
-fn assert_finite(data: &[[f64; 6]], _topology: &gradmesh::Topology, what: &str) {
+fn assert_finite(data: &[gradmesh::VertexData], _topology: &gradmesh::Topology, what: &str) {
     for (i, d) in data.iter().enumerate() {
         assert!(
-            d.iter().all(|x| x.is_finite()),
+            d.to_array().iter().all(|x| x.is_finite()),
             "{what}: vertex {i} is not finite: {d:?}"
         );
     }
