@@ -94,7 +94,7 @@ const MAX_SAMPLED_QUADS: usize = 400_000;
 
 impl SurfaceSamples {
     /// The limit points of `mesh` at the deepest of levels 2 to 4 that keeps within
-    /// [`MAX_SAMPLED_QUADS`]; `None` when the mesh has no faces or cannot be refined.
+    /// `MAX_SAMPLED_QUADS`; `None` when the mesh has no faces or cannot be refined.
     pub fn of(mesh: &GradientMesh) -> Option<SurfaceSamples> {
         if mesh.faces.is_empty() {
             return None;
