@@ -643,7 +643,8 @@ fn build_path(path: &mut BezPath, operator: &str, p: &[f64]) {
             curve(path, current, (p[0], p[1]), (p[2], p[3]));
         }
         "y" => curve(path, (p[0], p[1]), (p[2], p[3]), (p[2], p[3])),
-        "h" => path.close_path(),
+        // `h` without a current point does nothing (viewers ignore it).
+        "h" if !path.elements().is_empty() => path.close_path(),
         "re" => {
             path.move_to((p[0], p[1]));
             path.line_to((p[0] + p[2], p[1]));
