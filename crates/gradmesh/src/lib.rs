@@ -29,7 +29,7 @@
 //! let data = refinement.evaluate();
 //! // Limit position, colour and opacity of every level-3 vertex. Point `a` keeps its colour.
 //! let limit = refinement.limit(&data, 3);
-//! assert!((limit[refinement.vertex_at_level(a, 3)][2] - 50.0).abs() < 1e-12);
+//! assert!((limit[refinement.vertex_at_level(a, 3)].colour[0] - 50.0).abs() < 1e-12);
 //! # Ok::<(), gradmesh::Error>(())
 //! ```
 
