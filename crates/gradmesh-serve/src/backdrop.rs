@@ -123,9 +123,11 @@ pub fn read_pdf(path: &Path) -> Result<Read, String> {
         .map(|fill| vec![LayerSource::Patches(fill)])
         .collect();
     let fit = fit_to_file(&mut read.document.layers, &fills, 1.0);
-    if fit != FITTED {
-        read.warnings
-            .push(gradmesh::Warning::new(WarningKind::PdfLeftOut, fit));
+    if fit != ColourFit::Fitted {
+        read.warnings.push(gradmesh::Warning::new(
+            WarningKind::PdfLeftOut,
+            fit.to_string(),
+        ));
     }
     let messages: Vec<&str> = read.warnings.iter().map(|w| w.message.as_str()).collect();
     let backdrop = (!messages.is_empty()).then(|| Backdrop {
@@ -145,23 +147,50 @@ pub fn read_pdf(path: &Path) -> Result<Read, String> {
 /// 2-core machine, and an SVG exported from a mesh (thousands of one-patch gradients) minutes.
 pub const MAX_FITTED_PATCHES: usize = 256;
 
+/// What became of a file's colours when it was opened: what the File panel's message says.
+#[derive(Clone, Debug, PartialEq)]
+enum ColourFit {
+    /// Fitted to the file's own painting.
+    Fitted,
+    /// Left as converted: the layers hold this many patches, over [`MAX_FITTED_PATCHES`].
+    TooManyPatches(usize),
+    /// Left as converted: the fit failed, for this reason.
+    Failed(String),
+}
+
+impl std::fmt::Display for ColourFit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ColourFit::Fitted => {
+                write!(f, "Colours fitted to the file's own painting of its meshes")
+            }
+            ColourFit::TooManyPatches(patches) => write!(
+                f,
+                "Colours as converted, not fitted to the file's painting ({patches} patches, over \
+                 {MAX_FITTED_PATCHES}; `gradmesh convert --fit` fits them)"
+            ),
+            ColourFit::Failed(why) => write!(
+                f,
+                "Colours as converted: the fit to the file's painting failed ({why})"
+            ),
+        }
+    }
+}
+
 /// Fits the colours of `layers` (and colour edits at a refined level where the control colours
 /// cannot follow) to the file's own painting of the fills each holds, `fills[i]` for layer `i`,
 /// as `gradmesh convert --fit` does: the scheme's surface then looks as the file does, not as
 /// the plain conversion of its patches. `pixels_per_unit` is the file's scale (its fills are
 /// painted at that scale or finer). Layers of more than [`MAX_FITTED_PATCHES`] patches in all,
-/// or that the fit cannot take, are left as converted. Returns what the message says of it.
+/// or that the fit cannot take, are left as converted.
 fn fit_to_file(
     layers: &mut [gradmesh::GradientMesh],
     fills: &[Vec<LayerSource>],
     pixels_per_unit: f64,
-) -> String {
+) -> ColourFit {
     let patches: usize = layers.iter().map(|l| l.faces.len()).sum();
     if patches > MAX_FITTED_PATCHES {
-        return format!(
-            "Colours as converted, not fitted to the file's painting ({patches} patches, over \
-             {MAX_FITTED_PATCHES}; `gradmesh convert --fit` fits them)"
-        );
+        return ColourFit::TooManyPatches(patches);
     }
     let fills: Vec<&[LayerSource]> = fills.iter().map(Vec::as_slice).collect();
     let options = ClassicFitOptions {
@@ -172,14 +201,11 @@ fn fit_to_file(
     match fit_joined_to_classic(&mut fitted, &fills, &options) {
         Ok(_) => {
             layers.clone_from_slice(&fitted);
-            FITTED.to_string()
+            ColourFit::Fitted
         }
-        Err(e) => format!("Colours as converted: the fit to the file's painting failed ({e})"),
+        Err(e) => ColourFit::Failed(e.to_string()),
     }
 }
-
-/// What the message says of colours fitted to the file's painting.
-const FITTED: &str = "Colours fitted to the file's own painting of its meshes";
 
 /// "NAME: only its patch-mesh shadings are read; left out or read differently: text is not
 /// drawn; …"
