@@ -304,7 +304,7 @@ fn profile_drag(name: &str, doc: &Document, t: Target) {
     render::render_document_into_cached(doc, &opts, &mut exact_cache, &mut pixels)
         .expect("renders");
     let n = steps();
-    let mut stages: Vec<[Duration; 7]> = Vec::with_capacity(n);
+    let mut stages: Vec<[Duration; 10]> = Vec::with_capacity(n);
     for step in 1..=n {
         let text = drag_command(t, step);
         let command: gradmesh_serve::Command = serde_json::from_str(&text).expect("a command");
@@ -336,6 +336,9 @@ fn profile_drag(name: &str, doc: &Document, t: Target) {
             info.timings.draw,
             whole,
             exact,
+            info.layers.iter().map(|l| l.timings.refine).sum(),
+            info.layers.iter().map(|l| l.timings.evaluate).sum(),
+            info.layers.iter().map(|l| l.timings.tessellate).sum(),
         ]);
     }
     let start = Instant::now();
@@ -351,12 +354,15 @@ fn profile_drag(name: &str, doc: &Document, t: Target) {
     };
     println!(
         "{name} drag stages (medians): apply and validate {:.2} ms, copy of the visible layers {:.2} ms, \
-         draft render {:.2} ms (prepare {:.2}, draw {:.2}; exact render {:.2} ms); whole step {:.2} ms; \
+         draft render {:.2} ms (prepare {:.2}: refine {:.2}, evaluate {:.2}, triangles {:.2}; draw {:.2}; exact render {:.2} ms); whole step {:.2} ms; \
          the exact frame at the drag's end {release:.2} ms, then its folds {folds:.2} ms",
         median(0),
         median(1),
         median(2),
         median(3),
+        median(7),
+        median(8),
+        median(9),
         median(4),
         median(6),
         median(5)
