@@ -324,7 +324,8 @@ pub struct RefineArgs {
 pub struct VectoriseArgs {
     /// The picture (.png or .jpg); its pixels are the output's coordinates.
     pub input: PathBuf,
-    /// Output file (.json): one mesh covering the picture.
+    /// Output file (.json): one mesh covering the picture, or its opaque part where some pixels
+    /// are transparent.
     #[arg(short, long)]
     pub output: PathBuf,
     /// The most control points (default 1024 when --psnr is not given either).

@@ -226,8 +226,10 @@ fn decode_jpeg(bytes: &[u8], max_pixels: u64) -> Result<RgbaImage, Error> {
 }
 
 /// Peak signal-to-noise ratio of `b` against `a` in decibels, over the 8-bit sRGB colour
-/// channels of every pixel (alpha is not compared): `10 log10(255^2 / MSE)`, infinite for
-/// equal pictures. The two must have the same size.
+/// channels of every pixel premultiplied by its alpha (the pictures over black, so that a
+/// transparent pixel where the other is opaque counts, and colours where both are transparent
+/// do not): `10 log10(255^2 / MSE)`, infinite for equal pictures. The two must have the same
+/// size.
 pub fn psnr(a: &RgbaImage, b: &RgbaImage) -> Result<f64, Error> {
     if (a.width, a.height) != (b.width, b.height) {
         return Err(invalid(
@@ -238,14 +240,16 @@ pub fn psnr(a: &RgbaImage, b: &RgbaImage) -> Result<f64, Error> {
             ),
         ));
     }
-    let eight = |c: f32| (c.clamp(0.0, 1.0) * 255.0).round() as f64;
+    let eight = |p: &[f32; 4], k: usize| {
+        (p[k].clamp(0.0, 1.0) * p[3].clamp(0.0, 1.0) * 255.0).round() as f64
+    };
     let sum: f64 = a
         .pixels
         .iter()
         .zip(&b.pixels)
         .map(|(p, q)| {
             (0..3)
-                .map(|k| (eight(p[k]) - eight(q[k])).powi(2))
+                .map(|k| (eight(p, k) - eight(q, k)).powi(2))
                 .sum::<f64>()
         })
         .sum();

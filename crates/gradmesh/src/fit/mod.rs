@@ -13,7 +13,9 @@
 //! budget or the PSNR asked for is reached. Then the points move by damped Gauss-Newton steps
 //! ([`geometry`]), the colours solved again after each, while the error falls and the surface
 //! stays free of folds. The mesh is written with its faces along a Hilbert curve and its points
-//! numbered as the faces first use them ([`order`]), for a small gzipped file.
+//! numbered as the faces first use them ([`order`]), for a small gzipped file. A picture with
+//! transparent pixels keeps the cells that are mostly opaque, splits those its silhouette
+//! crosses, and puts the mesh's outline on it ([`silhouette`]).
 
 mod detail;
 mod geometry;
@@ -22,6 +24,7 @@ mod order;
 mod quadtree;
 mod raster;
 mod rows;
+mod silhouette;
 mod solve;
 
 use std::collections::{HashMap, HashSet};
@@ -33,13 +36,15 @@ use crate::limit_surface::limit_stencils;
 use crate::mesh::{Document, FirstStep, GradientMesh};
 use crate::refine::Refinement;
 use crate::render::{render_document_into, RenderOptions, View};
+use crate::scheme::BoundaryInterpolation;
 use crate::size_limits::Limits;
 
 pub use image::{psnr, RgbaImage, MAX_IMAGE_BYTES, MAX_IMAGE_PIXELS};
 
 pub use detail::{fit_colours_with_detail, DetailFit, DetailOptions};
 use image::{psnr_of_sum, Target};
-use quadtree::{Key, Quadtree};
+use quadtree::{Key, Quadtree, TreeMesh};
+use silhouette::Silhouette;
 
 use detail::DetailEdits;
 use raster::Observation;
@@ -339,7 +344,8 @@ fn psnr_of_covered(errors: &[Option<f64>]) -> f64 {
 }
 
 /// Per pixel, the squared 8-bit sRGB error summed over the channels of what the fitted surface
-/// shows against the picture (`None` where the surface does not reach).
+/// shows against the picture, times the pixel's alpha (`None` where the surface does not
+/// reach).
 fn pixel_errors(
     fitted: &Fitted,
     target: &Target,
@@ -354,17 +360,18 @@ fn pixel_errors(
             let c = fitted.observation.predict(&fitted.vertex_colours, i)?;
             let rgb = space.to_linear_srgb(c).map(srgb_encode);
             let p = image.pixels[i];
-            Some(
-                (0..3)
-                    .map(|k| (eight(rgb[k]) - eight(p[k] as f64)).powi(2))
-                    .sum(),
-            )
+            let error: f64 = (0..3)
+                .map(|k| (eight(rgb[k]) - eight(p[k] as f64)).powi(2))
+                .sum();
+            Some(target.weight[i] * error)
         })
         .collect()
 }
 
 /// Turns a picture into a document of one gradient mesh in its pixel coordinates (see the
-/// module's documentation), within `options`' budget.
+/// module's documentation), within `options`' budget. Where some pixels are transparent
+/// (alpha below one half) the mesh covers the others alone, its outline on their silhouette;
+/// a picture with no opaque pixel is an error.
 pub fn vectorise(image: &RgbaImage, options: &VectoriseOptions) -> Result<Vectorised, Error> {
     vectorise_with_progress(image, options, |_| {})
 }
@@ -406,11 +413,35 @@ pub fn vectorise_with_progress(
     };
     let (cols, rows) = initial_grid(w, h, start, min_px);
     let mut tree = Quadtree::new(w, h, cols, rows);
+    let silhouette = Silhouette::of(image);
+    if silhouette.as_ref().is_some_and(Silhouette::is_empty) {
+        return Err(invalid(
+            "image",
+            "every pixel is transparent: there is nothing to trace",
+        ));
+    }
     let mut known: HashMap<Key, [f64; 3]> = HashMap::new();
     let mut round = 0;
     loop {
-        let shape = tree.mesh();
-        let mesh = tree_mesh(&shape, &known, &target, space);
+        let (shape, leaf_of_face) = faces_of_tree(&tree, silhouette.as_ref());
+        if shape.faces.is_empty() {
+            // The opaque part is smaller than every cell: split the cells over it.
+            let s = silhouette
+                .as_ref()
+                .expect("an opaque picture keeps every cell");
+            let chosen = splits_over_silhouette(&tree, s, min_px, budget);
+            if chosen.is_empty() {
+                return Err(invalid(
+                    "image",
+                    format!(
+                        "the opaque part of the picture is too small to trace within {budget} points"
+                    ),
+                ));
+            }
+            tree.split(&chosen);
+            continue;
+        }
+        let mesh = tree_mesh(&shape, &known, &target, space, silhouette.is_some());
         let guess = mesh.points.iter().map(|p| p.colour).collect();
         let fitted = fit_mesh(&mesh, &target, &settings, guess)?;
         known = shape
@@ -420,7 +451,11 @@ pub fn vectorise_with_progress(
             .zip(fitted.colours.iter().copied())
             .collect();
         let errors = pixel_errors(&fitted, &target, image, space);
-        let model_psnr = psnr_of_errors(&errors);
+        let leaf_errors = leaf_errors(&tree, &fitted, &errors, &leaf_of_face, silhouette.as_ref());
+        let model_psnr = match silhouette {
+            None => psnr_of_errors(&errors),
+            Some(_) => psnr_of_sum(leaf_errors.iter().sum(), 3 * errors.len()),
+        };
         round += 1;
         progress(&Progress {
             round,
@@ -431,7 +466,8 @@ pub fn vectorise_with_progress(
         let chosen = if reached {
             Vec::new()
         } else {
-            choose_splits(&tree, &fitted, &errors, budget, quality.growth(), min_px)
+            let chosen = choose_splits(&tree, &leaf_errors, budget, quality.growth(), min_px);
+            within_budget(&tree, chosen, budget, silhouette.as_ref())
         };
         if chosen.is_empty() {
             let mut fit = Fit {
@@ -449,6 +485,9 @@ pub fn vectorise_with_progress(
                     &mut progress,
                 )?;
             }
+            if let Some(s) = &silhouette {
+                fit.snap_outline(s, &target, image, &settings)?;
+            }
             fit.set_colours();
             if options.round_output {
                 let coarse = psnr_of_sum(fit.error, 3 * image.pixels.len()) < COARSE_ROUNDING_DB;
@@ -461,22 +500,94 @@ pub fn vectorise_with_progress(
     }
 }
 
-/// The mesh of a quadtree's `shape`: one face per leaf, its points coloured as `known` (by
-/// key) or else as the picture under them.
+/// The faces of `tree`'s mesh: one per leaf, or with a silhouette one per leaf it keeps
+/// ([`silhouette::kept_faces`]); and per face, its leaf.
+fn faces_of_tree(tree: &Quadtree, silhouette: Option<&Silhouette>) -> (TreeMesh, Vec<usize>) {
+    let shape = tree.mesh();
+    match silhouette {
+        Some(s) => silhouette::kept_faces(shape, tree, s),
+        None => {
+            let leaves = (0..shape.faces.len()).collect();
+            (shape, leaves)
+        }
+    }
+}
+
+/// The leaves that can be split and hold pixels on the wrong side of the outline, as many as
+/// keep the tree within `budget` points.
+fn splits_over_silhouette(
+    tree: &Quadtree,
+    silhouette: &Silhouette,
+    min_px: f64,
+    budget: usize,
+) -> Vec<usize> {
+    let mut chosen: Vec<usize> = (0..tree.leaves.len())
+        .filter(|&i| {
+            let leaf = &tree.leaves[i];
+            tree.can_split(leaf, min_px) && silhouette.miscovered_error(tree, leaf) > 0.0
+        })
+        .collect();
+    let mut present = tree.corner_keys();
+    let mut kept = 0;
+    for &i in &chosen {
+        present.extend(Quadtree::new_points(&tree.leaves[i], &present));
+        if present.len() > budget {
+            break;
+        }
+        kept += 1;
+    }
+    chosen.truncate(kept);
+    chosen
+}
+
+/// `chosen` splits, or the first half of them as often as needed, so that the mesh of the
+/// split tree has at most `budget` points. Only a silhouette can make it have more points than
+/// the tree has corners: a point where kept cells touch at a corner alone becomes one per fan.
+fn within_budget(
+    tree: &Quadtree,
+    mut chosen: Vec<usize>,
+    budget: usize,
+    silhouette: Option<&Silhouette>,
+) -> Vec<usize> {
+    if silhouette.is_none() {
+        return chosen;
+    }
+    while !chosen.is_empty() {
+        let mut split = tree.clone();
+        split.split(&chosen);
+        if faces_of_tree(&split, silhouette).0.positions.len() <= budget {
+            break;
+        }
+        chosen.truncate(chosen.len() / 2);
+    }
+    chosen
+}
+
+/// The mesh of a quadtree's `shape`: its faces, its points coloured as `known` (by key) or
+/// else as the picture under them. The mesh of a silhouette (`outlined`) has a smooth outline
+/// (every boundary point follows the B-spline rule) except at the picture's corners.
 fn tree_mesh(
-    shape: &quadtree::TreeMesh,
+    shape: &TreeMesh,
     known: &HashMap<Key, [f64; 3]>,
     target: &Target,
     space: ColourSpace,
+    outlined: bool,
 ) -> GradientMesh {
     let mut mesh = GradientMesh::new(space);
     mesh.name = Some("vectorised".into());
+    let (w, h) = (target.width as f64, target.height as f64);
     for (k, p) in shape.keys.iter().zip(&shape.positions) {
         let colour = known
             .get(k)
             .copied()
             .unwrap_or_else(|| target_colour_at(target, *p));
         mesh.add_point(*p, colour);
+        if outlined && (p.x == 0.0 || p.x == w) && (p.y == 0.0 || p.y == h) {
+            mesh.points.last_mut().expect("just added").corner = true;
+        }
+    }
+    if outlined {
+        mesh.boundary = BoundaryInterpolation::EdgeOnly;
     }
     for f in &shape.faces {
         mesh.add_face(f.clone());
@@ -617,6 +728,68 @@ impl Fit {
     }
 }
 
+impl Fit {
+    /// Moves the points of the outline (away from the picture's sides) so that its limit curve
+    /// runs along the silhouette's edge, then solves the colours again. Each boundary point's
+    /// limit lies at `(previous + 4 point + next) / 6` (the outline's points follow the cubic
+    /// B-spline rule); [`SNAP_ITERATIONS`] times over, each point moves by half of what would
+    /// put that limit on the nearest point of the edge within half its shortest edge. The
+    /// points of faces the moves fold stay where they were.
+    fn snap_outline(
+        &mut self,
+        silhouette: &Silhouette,
+        target: &Target,
+        image: &RgbaImage,
+        settings: &FitSettings,
+    ) -> Result<(), Error> {
+        let (w, h) = (target.width as f64, target.height as f64);
+        let edges = outline_edges(&self.mesh, w, h);
+        let previous: HashMap<u32, u32> = edges.iter().map(|&(a, b)| (b, a)).collect();
+        let reach = shortest_edges(&self.mesh);
+        let mut trial = self.mesh.clone();
+        for _ in 0..SNAP_ITERATIONS {
+            let at: Vec<kurbo::Point> = trial.points.iter().map(|p| p.position).collect();
+            for &(v, next) in &edges {
+                let (i, p) = (v as usize, at[v as usize]);
+                let Some(&before) = previous.get(&v) else {
+                    continue;
+                };
+                if trial.points[i].corner || p.x == 0.0 || p.x == w || p.y == 0.0 || p.y == h {
+                    continue;
+                }
+                let limit = ((at[before as usize].to_vec2()
+                    + 4.0 * p.to_vec2()
+                    + at[next as usize].to_vec2())
+                    / 6.0)
+                    .to_point();
+                if let Some(edge) = silhouette.nearest_edge(limit, (0.5 * reach[i]).max(2.0)) {
+                    trial.points[i].position += (edge - limit) * 0.75;
+                }
+            }
+        }
+        let folds = find_folds(&trial)?;
+        for f in folds.iter().flat_map(|f| &f.faces) {
+            for &v in &trial.faces[*f] {
+                trial.points[v as usize].position = self.mesh.points[v as usize].position;
+            }
+        }
+        if !folds.is_empty() && !find_folds(&trial)?.is_empty() {
+            return Ok(());
+        }
+        let fitted = fit_mesh(&trial, target, settings, self.fitted.colours.clone())?;
+        let error = psnr_sum(&pixel_errors(&fitted, target, image, trial.colour_space));
+        *self = Fit {
+            mesh: trial,
+            fitted,
+            error,
+        };
+        Ok(())
+    }
+}
+
+/// How often [`Fit::snap_outline`] moves the outline's points towards the silhouette's edge.
+const SNAP_ITERATIONS: usize = 6;
+
 /// The most rounds of position steps for a mesh of `points` points: `quality`'s for 1024
 /// points or more, and for fewer up to three times as many, in proportion to `1024 / points`.
 /// Small meshes gain most from moved points (each point carries a large part of the picture)
@@ -630,11 +803,23 @@ fn position_rounds(quality: Quality, points: usize) -> usize {
 /// How often [`Fit::move_points`] freezes the points of folded faces and tries again.
 const FOLD_RETRIES: usize = 3;
 
-/// Shortens each step to at most a quarter of its point's shortest edge, and keeps points on
-/// the sides of the `width` x `height` picture on them (its corners where they are).
+/// Shortens each step to at most a quarter of its point's shortest edge, keeps points on
+/// the sides of the `width` x `height` picture on them (its corners where they are), and
+/// points of the outline elsewhere (a silhouette's) where they are: the colour error cannot
+/// tell where the outline should go ([`Fit::snap_outline`] moves them).
 fn limit_steps(mesh: &GradientMesh, steps: &mut [[f64; 2]], width: f64, height: f64) {
     let reach = shortest_edges(mesh);
-    for ((step, p), reach) in steps.iter_mut().zip(&mesh.points).zip(reach) {
+    let on_outline = outline_points(mesh, width, height);
+    for (((step, p), reach), outline) in steps
+        .iter_mut()
+        .zip(&mesh.points)
+        .zip(reach)
+        .zip(on_outline)
+    {
+        if outline {
+            *step = [0.0; 2];
+            continue;
+        }
         let length = step[0].hypot(step[1]);
         let limit = 0.25 * reach;
         if length > limit {
@@ -648,6 +833,43 @@ fn limit_steps(mesh: &GradientMesh, steps: &mut [[f64; 2]], width: f64, height: 
             step[1] = 0.0;
         }
     }
+}
+
+/// Per point, whether it lies on the mesh's outline away from the picture's sides.
+fn outline_points(mesh: &GradientMesh, width: f64, height: f64) -> Vec<bool> {
+    let mut on = vec![false; mesh.points.len()];
+    for (a, b) in outline_edges(mesh, width, height) {
+        on[a as usize] = true;
+        on[b as usize] = true;
+    }
+    on
+}
+
+/// The edges of the mesh's outline, each from a point to the next along its loop, except
+/// those along the sides of the `width` x `height` picture (which stay where they are): the
+/// directed edges of faces whose reverse no face has.
+fn outline_edges(mesh: &GradientMesh, width: f64, height: f64) -> Vec<(u32, u32)> {
+    let mut directed = HashSet::new();
+    for f in &mesh.faces {
+        for (i, &a) in f.iter().enumerate() {
+            directed.insert((a, f[(i + 1) % f.len()]));
+        }
+    }
+    let on_side = |a: u32, b: u32| {
+        let (p, q) = (
+            mesh.points[a as usize].position,
+            mesh.points[b as usize].position,
+        );
+        (p.x == q.x && (p.x == 0.0 || p.x == width))
+            || (p.y == q.y && (p.y == 0.0 || p.y == height))
+    };
+    let mut edges: Vec<(u32, u32)> = directed
+        .iter()
+        .filter(|&&(a, b)| !directed.contains(&(b, a)) && !on_side(a, b))
+        .copied()
+        .collect();
+    edges.sort_unstable();
+    edges
 }
 
 /// Per point, the length of its shortest edge.
@@ -669,23 +891,40 @@ fn target_colour_at(target: &Target, p: kurbo::Point) -> [f64; 3] {
     target.colour[y * target.width + x]
 }
 
-/// The leaves to split next: largest error first, adding at most `(growth - 1)` times the
-/// points there are and never going past `budget`.
-fn choose_splits(
+/// Per leaf of `tree`, the summed squared error of the pixels of the face it is
+/// (`leaf_of_face`), and with a silhouette what its pixels on the wrong side of the outline
+/// cost ([`Silhouette::miscovered_error`]).
+fn leaf_errors(
     tree: &Quadtree,
     fitted: &Fitted,
     errors: &[Option<f64>],
-    budget: usize,
-    growth: f64,
-    min_px: f64,
-) -> Vec<usize> {
+    leaf_of_face: &[usize],
+    silhouette: Option<&Silhouette>,
+) -> Vec<f64> {
     let mut leaf_error = vec![0.0; tree.leaves.len()];
     for (i, e) in errors.iter().enumerate() {
         let f = fitted.observation.base_face[i];
         if let (Some(e), true) = (e, f != raster::UNCOVERED) {
-            leaf_error[f as usize] += e;
+            leaf_error[leaf_of_face[f as usize]] += e;
         }
     }
+    if let Some(s) = silhouette {
+        for (error, leaf) in leaf_error.iter_mut().zip(&tree.leaves) {
+            *error += s.miscovered_error(tree, leaf);
+        }
+    }
+    leaf_error
+}
+
+/// The leaves to split next: largest error (`leaf_error`) first, adding at most `(growth - 1)`
+/// times the points there are and never going past `budget`.
+fn choose_splits(
+    tree: &Quadtree,
+    leaf_error: &[f64],
+    budget: usize,
+    growth: f64,
+    min_px: f64,
+) -> Vec<usize> {
     let mut order: Vec<usize> = (0..tree.leaves.len())
         .filter(|&i| tree.can_split(&tree.leaves[i], min_px) && leaf_error[i] > 0.0)
         .collect();

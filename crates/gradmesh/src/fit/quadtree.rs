@@ -92,6 +92,14 @@ impl Quadtree {
         )
     }
 
+    /// A leaf's top-left and bottom-right corners, in pixels.
+    pub fn cell_corners(&self, c: &Cell) -> (Point, Point) {
+        (
+            self.position((c.x, c.y)),
+            self.position((c.x + c.size, c.y + c.size)),
+        )
+    }
+
     /// The smaller side of a leaf, in pixels.
     pub fn side_px(&self, c: &Cell) -> f64 {
         let f = c.size as f64 / ROOT_SIDE as f64;

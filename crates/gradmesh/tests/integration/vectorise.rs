@@ -434,3 +434,133 @@ fn rounded_output_of_a_photograph_like_fit_is_coarse() {
         positions.len()
     );
 }
+
+/// A 160 x 120 picture: an opaque ellipse of smoothly varying colour, transparent around it,
+/// and whether each pixel is inside.
+fn ellipse_on_transparent() -> (RgbaImage, Vec<bool>) {
+    let (w, h) = (160u32, 120u32);
+    let mut pixels = Vec::new();
+    let mut inside = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let (fx, fy) = (x as f32 + 0.5, y as f32 + 0.5);
+            let within = ((fx - 80.0) / 62.0).powi(2) + ((fy - 60.0) / 42.0).powi(2) < 1.0;
+            let colour = [0.2 + 0.6 * fx / w as f32, 0.3 + 0.5 * fy / h as f32, 0.5];
+            pixels.push([
+                colour[0],
+                colour[1],
+                colour[2],
+                if within { 1.0 } else { 0.0 },
+            ]);
+            inside.push(within);
+        }
+    }
+    (
+        RgbaImage {
+            width: w,
+            height: h,
+            pixels,
+        },
+        inside,
+    )
+}
+
+/// Transparent pixels are outside: the mesh covers the opaque ellipse alone, its outline on
+/// the ellipse's edge, and the colours inside match.
+#[test]
+fn a_transparent_background_is_left_out() {
+    let (image, inside) = ellipse_on_transparent();
+    let options = VectoriseOptions {
+        points: Some(120),
+        ..VectoriseOptions::default()
+    };
+    let v = vectorise(&image, &options).unwrap();
+    assert!(v.points <= 120, "{} points", v.points);
+    let back = render(&v.document, image.width, image.height);
+    let covered: Vec<bool> = back.pixels.iter().map(|p| p[3] >= 0.5).collect();
+    let both = covered
+        .iter()
+        .zip(&inside)
+        .filter(|(c, i)| **c && **i)
+        .count();
+    let either = covered
+        .iter()
+        .zip(&inside)
+        .filter(|(c, i)| **c || **i)
+        .count();
+    let overlap = both as f64 / either as f64;
+    assert!(overlap > 0.97, "covered and inside overlap {overlap}");
+    // Over the picture as it is (transparent pixels count as black in both), and the colours
+    // where both are opaque.
+    assert!(v.psnr > 25.0, "{} dB", v.psnr);
+    let (mut sum, mut n) = (0.0, 0);
+    for ((p, q), (&c, &i)) in image
+        .pixels
+        .iter()
+        .zip(&back.pixels)
+        .zip(covered.iter().zip(&inside))
+    {
+        if c && i {
+            sum += (0..3)
+                .map(|k| ((p[k] - q[k]) as f64 * 255.0).powi(2))
+                .sum::<f64>();
+            n += 3;
+        }
+    }
+    let inside_psnr = 10.0 * (255.0f64.powi(2) * n as f64 / sum).log10();
+    assert!(inside_psnr > 35.0, "{inside_psnr} dB where both are opaque");
+}
+
+/// A picture with no opaque pixel has nothing to trace: a clear error.
+#[test]
+fn a_wholly_transparent_picture_is_refused() {
+    let image = RgbaImage::filled(40, 30, [0.5, 0.5, 0.5, 0.0]);
+    let e = vectorise(&image, &VectoriseOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("transparent"), "{e}");
+}
+
+/// Opacity as noise (a checkerboard of opaque and transparent pixels, and random ones): the
+/// fit stays within its budget and gives a valid mesh, or says the opaque part is too small.
+#[test]
+fn scattered_opacity_stays_within_the_budget() {
+    let (w, h) = (48u32, 32u32);
+    let mut state = 7u64;
+    let mut random = move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 33) as u32
+    };
+    let checkerboard = |x: u32, y: u32| (x + y) % 2 == 0;
+    let pictures = [
+        (0..w * h)
+            .map(|i| checkerboard(i % w, i / w))
+            .collect::<Vec<_>>(),
+        (0..w * h).map(|_| random() % 3 == 0).collect(),
+        (0..w * h)
+            .map(|i| checkerboard(i % w / 8, i / w / 8))
+            .collect(),
+    ];
+    for opaque in pictures {
+        let image = RgbaImage {
+            width: w,
+            height: h,
+            pixels: opaque
+                .iter()
+                .map(|&o| [0.3, 0.6, 0.2, if o { 1.0 } else { 0.0 }])
+                .collect(),
+        };
+        let options = VectoriseOptions {
+            points: Some(40),
+            quality: Quality::Fast,
+            ..VectoriseOptions::default()
+        };
+        match vectorise(&image, &options) {
+            Ok(v) => {
+                assert!(v.points <= 40, "{} points", v.points);
+                gradmesh::validate(&v.document.layers[0]).expect("a valid mesh");
+            }
+            Err(e) => assert!(e.to_string().contains("too small to trace"), "{e}"),
+        }
+    }
+}
