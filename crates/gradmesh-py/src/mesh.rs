@@ -368,7 +368,7 @@ impl Document {
     fn new(layers: Vec<Bound<'_, Mesh>>) -> Document {
         let layers = layers.iter().map(|m| m.get().mesh.clone()).collect();
         Document {
-            doc: gradmesh::Document { layers },
+            doc: gradmesh::Document::new(layers),
         }
     }
 

@@ -22,7 +22,7 @@ fn document_of<'a>(obj: &'a Bound<'_, PyAny>) -> PyResult<Cow<'a, gradmesh::Docu
     }
     if let Ok(mesh) = obj.cast::<Mesh>() {
         let layers = vec![mesh.get().mesh.clone()];
-        return Ok(Cow::Owned(gradmesh::Document { layers }));
+        return Ok(Cow::Owned(gradmesh::Document::new(layers)));
     }
     Err(invalid(format!(
         "expected a gradmesh.Document or gradmesh.Mesh, not {}",

@@ -79,7 +79,7 @@ fn artwork(files: &[&str]) -> Document {
             doc.layers.into_iter().next().expect("one layer")
         })
         .collect();
-    Document { layers }
+    Document::new(layers)
 }
 
 /// The options of the editor's first view of `doc` on a canvas of 1024 x 900 pixels, as the

@@ -97,7 +97,7 @@ pub fn read_svg(path: &Path) -> Result<Read, String> {
     let mut layers: Vec<_> = joined.into_iter().map(|j| j.mesh).collect();
     let pixels_per_unit = read.pixel_size.0 / read.view.width().max(1e-12);
     let fit = fit_to_file(&mut layers, &fills, pixels_per_unit);
-    let document = Document { layers };
+    let document = Document::new(layers);
     let kinds = read.warnings.iter().map(|w| w.kind);
     let backdrop = Backdrop {
         path: path.to_path_buf(),

@@ -182,7 +182,7 @@ impl Editor {
         let mut mesh = GradientMesh::new(ColourSpace::Lab);
         mesh.name = Some("Layer 1".into());
         Editor {
-            history: History::new(Picture::new(Document { layers: vec![mesh] })),
+            history: History::new(Picture::new(Document::new(vec![mesh]))),
             path: None,
         }
     }

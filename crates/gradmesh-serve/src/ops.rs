@@ -54,6 +54,7 @@ impl Picture {
                 .filter(|(_, hidden)| !**hidden)
                 .map(|(layer, _)| layer.clone())
                 .collect(),
+            view: self.doc.view,
         }
     }
 }

@@ -353,7 +353,7 @@ fn write_artwork(dir: &Path, name: &str, files: &[String]) -> PathBuf {
         })
         .collect();
     let file = dir.join(format!("{name}.json"));
-    let text = gradmesh::formats::json::write_document(&gradmesh::Document { layers });
+    let text = gradmesh::formats::json::write_document(&gradmesh::Document::new(layers));
     std::fs::write(&file, text).unwrap();
     file
 }

@@ -289,7 +289,7 @@ async fn tucan_layers(client: &Client, running: &Running, files: &[PathBuf]) -> 
         layers.extend(gradmesh::formats::read_path(file).unwrap().layers);
     }
     let whole = joined.path().join("tucan.json");
-    let text = gradmesh::formats::json::write_document(&gradmesh::Document { layers });
+    let text = gradmesh::formats::json::write_document(&gradmesh::Document::new(layers));
     std::fs::write(&whole, text).unwrap();
     let canvas = canvas_pixels(client).await;
     let worst = compare_with_render(client, &whole, &canvas).await;

@@ -72,7 +72,7 @@ fn real_document(names: &[String]) -> Option<Document> {
     for name in names {
         layers.extend(formats::read_path(&dir.join(name)).ok()?.layers);
     }
-    Some(Document { layers })
+    Some(Document::new(layers))
 }
 
 /// The six Tucan layers, bottom to top (the README's order).

@@ -55,9 +55,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         .unwrap_or_else(|| "/tmp/render_buffer.png".into());
     let size: u32 = args.next().map(|s| s.parse()).transpose()?.unwrap_or(512);
 
-    let doc = Document {
-        layers: vec![star()],
-    };
+    let doc = Document::new(vec![star()]);
     let bounds = document_bounds(&doc).ok_or("empty document")?;
     println!("bounds: {bounds:?}");
 

@@ -301,7 +301,7 @@ fn fit_rows(
     let mut g = grid(image.width as f64, image.height as f64, budget);
     fit_colours(&mut g, image, args.quality)?;
     let seconds = start.elapsed().as_secs_f64();
-    let grid_doc = Document { layers: vec![g] };
+    let grid_doc = Document::new(vec![g]);
     let (grid, _) = measure_document(&grid_doc, image, seconds, save("grid"))?;
     grid.print(stem, &format!("regular grid, {budget}"));
     Ok(())

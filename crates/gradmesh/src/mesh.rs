@@ -13,6 +13,17 @@ pub use crate::scheme::{BoundaryInterpolation, CreasingMethod, FirstStep, SHARPN
 pub struct Document {
     /// The meshes, bottom first.
     pub layers: Vec<GradientMesh>,
+    /// The part of the plane the picture shows, when the document says (a vectorised picture
+    /// whose mesh covers only part of it keeps the picture's rectangle): `gradmesh render`
+    /// draws it by default, one pixel per unit. `None`: the points' bounding box.
+    pub view: Option<kurbo::Rect>,
+}
+
+impl Document {
+    /// A document of `layers`, the first at the bottom, with no view of its own.
+    pub fn new(layers: Vec<GradientMesh>) -> Document {
+        Document { layers, view: None }
+    }
 }
 
 /// One control point of a gradient mesh.

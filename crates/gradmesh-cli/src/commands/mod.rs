@@ -105,9 +105,17 @@ fn read_with_viewport(path: &Path, limits: &gradmesh::Limits, page: usize) -> Re
             warnings: read.warnings,
         });
     }
+    let document = gradmesh::formats::read_path_with_limits(path, limits)?;
+    // A document's own view (a vectorised picture's rectangle), one pixel per unit.
+    let viewport = document.view.map(|v| {
+        (
+            gradmesh::render::View::from_rect(v),
+            (v.width(), v.height()),
+        )
+    });
     Ok(Input {
-        document: gradmesh::formats::read_path_with_limits(path, limits)?,
-        viewport: None,
+        document,
+        viewport,
         fills: None,
         warnings: Vec::new(),
     })

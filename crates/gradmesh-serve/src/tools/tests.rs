@@ -17,7 +17,7 @@ fn grid(columns: u32, rows: u32) -> GradientMesh {
 }
 
 fn picture(mesh: GradientMesh) -> Picture {
-    Picture::new(Document { layers: vec![mesh] })
+    Picture::new(Document::new(vec![mesh]))
 }
 
 /// Applies `op` to a picture of `mesh` through a history and checks what every tool promises;

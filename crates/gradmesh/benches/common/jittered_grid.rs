@@ -36,5 +36,5 @@ pub fn grid(w: u32, h: u32) -> Document {
             m.add_face(vec![a, a + 1, a + w + 2, a + w + 1]);
         }
     }
-    Document { layers: vec![m] }
+    Document::new(vec![m])
 }

@@ -62,5 +62,5 @@ pub fn document() -> Document {
             m.set_handle(b as u32, a as u32, handle(&p, b, a));
         }
     }
-    Document { layers: vec![m] }
+    Document::new(vec![m])
 }

@@ -21,7 +21,7 @@
 //! let b = mesh.add_point(Point::new(100.0, 0.0), [90.0, -10.0, 80.0]);
 //! let c = mesh.add_point(Point::new(50.0, 90.0), [40.0, 10.0, -50.0]);
 //! mesh.add_face(vec![a, b, c]);
-//! let doc = Document { layers: vec![mesh] };
+//! let doc = Document::new(vec![mesh]);
 //!
 //! let opts = ExportOptions::new(128, 128, View::new(-10.0, -10.0, 110.0, 110.0));
 //! let (pdf, info) = write_pdf(&doc, &opts)?;

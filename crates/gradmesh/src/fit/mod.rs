@@ -494,7 +494,7 @@ pub fn vectorise_with_progress(
                 round_for_output(&mut fit.mesh, coarse)?;
             }
             order::order_for_output(&mut fit.mesh, w, h);
-            return finish(fit.mesh, image, round);
+            return finish(fit.mesh, image, round, silhouette.is_some());
         }
         tree.split(&chosen);
     }
@@ -1037,10 +1037,21 @@ fn keep_fine_where_folded(
     Ok(())
 }
 
-/// The document of `mesh`, rendered at the picture's size to measure its PSNR.
-fn finish(mesh: GradientMesh, image: &RgbaImage, rounds: usize) -> Result<Vectorised, Error> {
+/// The document of `mesh`, rendered at the picture's size to measure its PSNR. A mesh of a
+/// silhouette (`framed`) does not span the picture: the document keeps the picture's rectangle
+/// as its view.
+fn finish(
+    mesh: GradientMesh,
+    image: &RgbaImage,
+    rounds: usize,
+    framed: bool,
+) -> Result<Vectorised, Error> {
     let points = mesh.points.len();
-    let document = Document { layers: vec![mesh] };
+    let (w, h) = (image.width as f64, image.height as f64);
+    let document = Document {
+        layers: vec![mesh],
+        view: framed.then(|| kurbo::Rect::new(0.0, 0.0, w, h)),
+    };
     let view = View::new(0.0, 0.0, image.width as f64, image.height as f64);
     let opts = RenderOptions::new(image.width, image.height, view);
     let mut out = vec![0u8; 4 * image.width as usize * image.height as usize];

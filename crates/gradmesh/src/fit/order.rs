@@ -143,9 +143,7 @@ mod tests {
     }
 
     fn render(mesh: &GradientMesh) -> Vec<u8> {
-        let document = Document {
-            layers: vec![mesh.clone()],
-        };
+        let document = Document::new(vec![mesh.clone()]);
         let opts = RenderOptions::new(160, 120, View::new(0.0, 0.0, 160.0, 120.0));
         let mut out = vec![0u8; 4 * 160 * 120];
         render_document_into(&document, &opts, &mut out).unwrap();
@@ -153,9 +151,7 @@ mod tests {
     }
 
     fn gzip_bytes(mesh: &GradientMesh) -> usize {
-        let document = Document {
-            layers: vec![mesh.clone()],
-        };
+        let document = Document::new(vec![mesh.clone()]);
         let text = crate::formats::json::write_document(&document);
         let mut encoder = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::best());
         encoder.write_all(text.as_bytes()).unwrap();

@@ -64,13 +64,28 @@ pub fn read_document_with_limits(text: &str, limits: &Limits) -> Result<Document
     let header: Header = serde_json::from_str(text).map_err(|e| serde_error(text, e))?;
     check_header(text, &header)?;
     let raw: RawDocument = serde_json::from_str(text).map_err(|e| serde_error(text, e))?;
+    let view = raw.view.map(|v| document_view(text, v.0)).transpose()?;
     let layers = raw
         .layers
         .into_iter()
         .enumerate()
         .map(|(l, layer)| convert_layer(text, l, layer, limits))
         .collect::<Result<_, _>>()?;
-    Ok(Document { layers })
+    Ok(Document { layers, view })
+}
+
+/// The document's `"view": [x0, y0, x1, y1]`: finite, with `x1 > x0` and `y1 > y0`.
+fn document_view(text: &str, [x0, y0, x1, y1]: [f64; 4]) -> Result<kurbo::Rect, Error> {
+    if [x0, y0, x1, y1].iter().all(|v| v.is_finite()) && x1 > x0 && y1 > y0 {
+        return Ok(kurbo::Rect::new(x0, y0, x1, y1));
+    }
+    let line = text
+        .find("\"view\"")
+        .map_or(1, |at| text[..at].matches('\n').count() + 1);
+    Err(Error::new(ErrorKind::Syntax(format!(
+        "{line}: view: expected [x0, y0, x1, y1] with x1 > x0 and y1 > y0, found \
+         [{x0}, {y0}, {x1}, {y1}]"
+    ))))
 }
 
 /// Refuses nesting deeper than `max_depth` before serde recurses into it.
@@ -205,6 +220,8 @@ struct RawDocument {
     _format: IgnoredAny,
     #[serde(rename = "version")]
     _version: IgnoredAny,
+    #[serde(default)]
+    view: Option<Numbers<4>>,
     layers: Vec<RawLayer>,
 }
 
@@ -1313,15 +1330,15 @@ fn colour_out(colour: [f64; 3], text: Option<&str>, space: ColourSpace) -> (Stri
 /// numbers are written as `null`.
 pub fn write_document(doc: &Document) -> String {
     let layers = doc.layers.iter().map(|l| write_layer(l, 4));
-    let top = block_object(
-        0,
-        &[
-            ("format", string(FORMAT_NAME)),
-            ("version", VERSION.to_string()),
-            ("layers", block_array(2, layers)),
-        ],
-    );
-    top + "\n"
+    let mut fields = vec![
+        ("format", string(FORMAT_NAME)),
+        ("version", VERSION.to_string()),
+    ];
+    if let Some(v) = doc.view {
+        fields.push(("view", numbers(&[v.x0, v.y0, v.x1, v.y1])));
+    }
+    fields.push(("layers", block_array(2, layers)));
+    block_object(0, &fields) + "\n"
 }
 
 fn write_layer(mesh: &GradientMesh, indent: usize) -> String {
@@ -1594,6 +1611,29 @@ mod tests {
         );
     }
 
+    /// A document's view is written after the version, read back as written, and refused
+    /// when it is empty or reversed.
+    #[test]
+    fn the_view_round_trips_and_bad_ones_are_refused() {
+        let mut mesh = GradientMesh::new(ColourSpace::Srgb);
+        for (x, y) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
+            mesh.add_point(Point::new(x, y), [0.5; 3]);
+        }
+        mesh.add_face([0, 1, 2, 3]);
+        let doc = Document {
+            layers: vec![mesh],
+            view: Some(kurbo::Rect::new(-2.0, 0.0, 3.5, 4.0)),
+        };
+        let text = write_document(&doc);
+        assert!(text.contains("\"view\": [-2.0, 0.0, 3.5, 4.0]"), "{text}");
+        let back = read_document(&text).unwrap();
+        assert_eq!(back, doc);
+        assert_eq!(write_document(&back), text);
+        let reversed = text.replace("[-2.0, 0.0, 3.5, 4.0]", "[3, 0, 1, 4]");
+        let e = read_document(&reversed).unwrap_err().to_string();
+        assert!(e.contains("4: view: expected"), "{e}");
+    }
+
     #[test]
     fn wedge_opacity_rules() {
         let mut mesh = GradientMesh::new(ColourSpace::Srgb);
@@ -1612,9 +1652,7 @@ mod tests {
                 opacity,
                 handles: BTreeMap::new(),
             }];
-            let doc = Document {
-                layers: vec![mesh.clone()],
-            };
+            let doc = Document::new(vec![mesh.clone()]);
             let text = write_document(&doc);
             let back = read_document(&text).unwrap();
             assert_eq!(back.layers[0].wedges[0].opacity, opacity, "{text}");
@@ -1813,9 +1851,7 @@ mod tests {
 
     #[test]
     fn empty_layers_are_written_compactly() {
-        let doc = Document {
-            layers: vec![GradientMesh::default()],
-        };
+        let doc = Document::new(vec![GradientMesh::default()]);
         let text = write_document(&doc);
         assert_eq!(
             text,

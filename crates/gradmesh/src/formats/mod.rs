@@ -227,7 +227,7 @@ pub(crate) fn error_at(line: usize, kind: ErrorKind) -> Error {
 }
 
 fn single_layer(mesh: GradientMesh) -> Document {
-    Document { layers: vec![mesh] }
+    Document::new(vec![mesh])
 }
 
 /// Distinguishes the temporary files of one process.

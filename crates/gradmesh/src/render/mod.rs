@@ -81,7 +81,7 @@
 //! let b = mesh.add_point(Point::new(100.0, 0.0), [90.0, -10.0, 80.0]);
 //! let c = mesh.add_point(Point::new(50.0, 90.0), [40.0, 10.0, -50.0]);
 //! mesh.add_face(vec![a, b, c]);
-//! let doc = Document { layers: vec![mesh] };
+//! let doc = Document::new(vec![mesh]);
 //!
 //! let opts = RenderOptions::fit(&doc, 64);
 //! let image = render_document(&doc, &opts)?;
@@ -153,9 +153,7 @@ pub fn render_image(doc: &Document, opts: &RenderOptions) -> Result<(Image, Rend
 
 /// Renders one mesh alone (a document of one layer) into a new image.
 pub fn render_mesh(mesh: &GradientMesh, opts: &RenderOptions) -> Result<Image, Error> {
-    let doc = Document {
-        layers: vec![mesh.clone()],
-    };
+    let doc = Document::new(vec![mesh.clone()]);
     render_document(&doc, opts)
 }
 
@@ -808,7 +806,7 @@ mod tests {
         let mut layers = read("Tucan_Tucan_Layer5.off");
         layers.extend(read("Tucan_Tucan_Layer2.off"));
         layers.extend(read("Glasses.off"));
-        let lab = Document { layers };
+        let lab = Document::new(layers);
         let mut other_spaces = lab.clone();
         other_spaces.layers[1].colour_space = ColourSpace::Oklab;
         other_spaces.layers[2].colour_space = ColourSpace::Srgb;

@@ -428,9 +428,7 @@ fn discontinuous_edges_keep_both_colours() {
 fn the_option_round_trips_through_the_native_format() {
     let mut mesh = binary(realdata("Tucan_Tucan_Layer0.off"));
     mesh.interpolate_positions = true;
-    let doc = Document {
-        layers: vec![mesh.clone(), grid(2, None)],
-    };
+    let doc = Document::new(vec![mesh.clone(), grid(2, None)]);
     let text = json::write_document(&doc);
     assert_eq!(text.matches("\"first_step\": \"binary\"").count(), 1);
     let back = json::read_document(&text).unwrap();

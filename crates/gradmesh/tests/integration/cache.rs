@@ -23,7 +23,7 @@ fn tucan() -> Document {
             doc.layers.remove(0)
         })
         .collect();
-    Document { layers }
+    Document::new(layers)
 }
 
 fn options(doc: &Document, width: u32) -> RenderOptions {
@@ -293,7 +293,7 @@ fn an_outline_change_draws_again_only_around_it() {
             mesh.add_face(vec![v, v + 1, v + columns + 2, v + columns + 1]);
         }
     }
-    let mut doc = Document { layers: vec![mesh] };
+    let mut doc = Document::new(vec![mesh]);
     let opts = options(&doc, 400);
     let band_pixels = |bands: usize| (bands * 16 * opts.width as usize) as u64;
     let left_middle = (columns + 1) as usize;

@@ -252,9 +252,7 @@ fn colours_far_outside_the_gamut() {
 
 #[test]
 fn a_mesh_outside_the_view_renders_transparent() {
-    let doc = Document {
-        layers: vec![sample()],
-    };
+    let doc = Document::new(vec![sample()]);
     for view in [
         View::new(100.0, 100.0, 110.0, 110.0),
         View::new(-1e9, -1e9, -1e9 + 10.0, -1e9 + 10.0),
@@ -269,7 +267,7 @@ fn a_mesh_outside_the_view_renders_transparent() {
     for p in &mut tiny.points {
         p.position = Point::new(1e6 + 1e-9 * p.position.x, 1e-9 * p.position.y);
     }
-    let doc = Document { layers: vec![tiny] };
+    let doc = Document::new(vec![tiny]);
     let image = render_document(
         &doc,
         &RenderOptions::new(8, 8, View::new(0.0, 0.0, 1e3, 1e3)),
@@ -281,9 +279,7 @@ fn a_mesh_outside_the_view_renders_transparent() {
 /// A view that lies inside one face shows the face everywhere.
 #[test]
 fn a_view_inside_a_face_is_covered() {
-    let doc = Document {
-        layers: vec![sample()],
-    };
+    let doc = Document::new(vec![sample()]);
     let image = render_document(
         &doc,
         &RenderOptions::new(8, 8, View::new(0.4, 0.4, 0.6, 0.6)),

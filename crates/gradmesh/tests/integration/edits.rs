@@ -293,9 +293,7 @@ fn an_edit_changes_the_picture_only_inside_its_support() {
     let view = View::new(-10.0, -10.0, 250.0, 250.0);
     let mut opts = RenderOptions::new(260, 260, view);
     opts.level = Some(4);
-    let doc = |m: &GradientMesh| Document {
-        layers: vec![m.clone()],
-    };
+    let doc = |m: &GradientMesh| Document::new(vec![m.clone()]);
     let before = render_document(&doc(&mesh), &opts).unwrap();
     let after = render_document(&doc(&edited), &opts).unwrap();
 
@@ -540,9 +538,7 @@ fn documents_with_edits_round_trip_through_the_native_format() {
         offset: Some(Vec2::new(0.1, -1.0 / 3.0)),
         ..Edit::new(VertexAddress::new(2, 0, 0, [1, 2]))
     }];
-    let doc = Document {
-        layers: vec![mesh, moving],
-    };
+    let doc = Document::new(vec![mesh, moving]);
     let text = write_document(&doc);
     let back = read_document(&text).unwrap();
     assert_eq!(back, doc);

@@ -337,9 +337,7 @@ fn cases() -> Vec<Case> {
         "a square of side 30000 at 1 pixel per unit",
         || {
             let opts = RenderOptions::new(30_000, 30_000, View::new(0.0, 0.0, 3e4, 3e4));
-            let doc = Document {
-                layers: vec![triangle()],
-            };
+            let doc = Document::new(vec![triangle()]);
             render_document(&doc, &opts).map(drop)
         },
     ));

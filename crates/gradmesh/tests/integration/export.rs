@@ -210,9 +210,7 @@ fn interior(doc: &Document, render: &RenderOptions) -> Vec<bool> {
         for p in &mut opaque.points {
             p.opacity = 1.0;
         }
-        let alone = Document {
-            layers: vec![opaque],
-        };
+        let alone = Document::new(vec![opaque]);
         let (image, _) = render_image(&alone, render).unwrap();
         let alpha = |x: i64, y: i64| image.data[4 * (y * w + x) as usize + 3];
         for y in 0..h {
@@ -470,9 +468,7 @@ pub(crate) fn translucent_document() -> Document {
             front.add_face(vec![ids[k], ids[k + 1], ids[k + 4], ids[k + 3]]);
         }
     }
-    Document {
-        layers: vec![back, front],
-    }
+    Document::new(vec![back, front])
 }
 
 #[test]
@@ -608,9 +604,7 @@ fn translucent_example() -> Document {
 /// along their sides would draw a grid of seams.
 #[test]
 fn translucent_svg_matches_the_render_in_inkscape_and_chromium() {
-    let star = Document {
-        layers: vec![translucent_star()],
-    };
+    let star = Document::new(vec![translucent_star()]);
     for (name, doc) in [
         ("translucent-star", star),
         ("translucent-example", translucent_example()),

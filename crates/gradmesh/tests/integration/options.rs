@@ -75,7 +75,7 @@ fn interpolation_is_exact_with_semi_sharp_creases() {
 fn the_option_round_trips_through_the_native_format() {
     let mut mesh = realdata("Tucan_Tucan_Layer0.off");
     mesh.interpolate_positions = true;
-    let doc = gradmesh::Document { layers: vec![mesh] };
+    let doc = gradmesh::Document::new(vec![mesh]);
     let text = json::write_document(&doc);
     assert!(text.contains("\"interpolate_positions\": true"));
     let back = json::read_document(&text).unwrap();

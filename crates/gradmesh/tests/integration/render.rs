@@ -118,7 +118,7 @@ fn annulus(centre: Point, r0: f64, r1: f64, n: u32) -> GradientMesh {
 }
 
 fn doc(layers: Vec<GradientMesh>) -> Document {
-    Document { layers }
+    Document::new(layers)
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -375,9 +375,7 @@ fn converted_files_show_their_stop_colours_at_the_mesh_corners() {
         let opts = RenderOptions::new(w, h, View::new(x0, y0, x1, y1));
         // Each layer alone: a later mesh, unclipped, may cover an earlier one's corner.
         for (mesh, fill) in doc.layers.iter().zip(&scene.fills) {
-            let alone = Document {
-                layers: vec![mesh.clone()],
-            };
+            let alone = Document::new(vec![mesh.clone()]);
             let image = render_document(&alone, &opts).unwrap_or_else(|e| panic!("{name}: {e}"));
             let grid = &fill.mesh;
             let (r, c) = (grid.rows, grid.columns);

@@ -64,13 +64,7 @@ fn a_flat_picture_fits_above_40_db() {
 #[test]
 fn fit_colours_recovers_a_rendered_mesh() {
     let truth = grid_mesh();
-    let image = render(
-        &Document {
-            layers: vec![truth.clone()],
-        },
-        120,
-        90,
-    );
+    let image = render(&Document::new(vec![truth.clone()]), 120, 90);
     let mut mesh = truth.clone();
     for p in &mut mesh.points {
         p.colour = [50.0, 0.0, 0.0];
@@ -91,7 +85,7 @@ fn fit_colours_recovers_a_rendered_mesh() {
 #[test]
 fn a_rendered_mesh_vectorises_back() {
     let mesh = grid_mesh();
-    let image = render(&Document { layers: vec![mesh] }, 120, 90);
+    let image = render(&Document::new(vec![mesh]), 120, 90);
     let options = VectoriseOptions {
         points: Some(40),
         ..VectoriseOptions::default()
@@ -102,6 +96,8 @@ fn a_rendered_mesh_vectorises_back() {
     // The document covers the picture: its render at the picture's size has no hole.
     let back = render(&v.document, 120, 90);
     assert!(back.pixels.iter().all(|p| p[3] > 0.99));
+    // Its mesh spans the picture: the document needs no view of its own.
+    assert_eq!(v.document.view, None);
     assert!((psnr(&image, &back).unwrap() - v.psnr).abs() < 1.0);
 }
 
@@ -138,13 +134,7 @@ fn noise_stays_within_the_budget() {
 /// The PSNR goal stops the refinement: a smooth picture needs few points for 30 dB.
 #[test]
 fn a_psnr_goal_stops_early() {
-    let image = render(
-        &Document {
-            layers: vec![grid_mesh()],
-        },
-        120,
-        90,
-    );
+    let image = render(&Document::new(vec![grid_mesh()]), 120, 90);
     let options = VectoriseOptions {
         psnr: Some(30.0),
         ..VectoriseOptions::default()
@@ -490,6 +480,11 @@ fn a_transparent_background_is_left_out() {
         .count();
     let overlap = both as f64 / either as f64;
     assert!(overlap > 0.97, "covered and inside overlap {overlap}");
+    let view = v.document.view.expect("the picture's rectangle");
+    assert_eq!(
+        (view.x0, view.y0, view.x1, view.y1),
+        (0.0, 0.0, 160.0, 120.0)
+    );
     // Over the picture as it is (transparent pixels count as black in both), and the colours
     // where both are opaque.
     assert!(v.psnr > 25.0, "{} dB", v.psnr);

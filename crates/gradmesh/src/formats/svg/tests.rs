@@ -785,7 +785,7 @@ fn an_exported_translucent_layer_reads_back_translucent() {
         mesh.points[*id as usize].opacity = opacity;
     }
     mesh.add_face(p.to_vec());
-    let doc = Document { layers: vec![mesh] };
+    let doc = Document::new(vec![mesh]);
     let opts = ExportOptions::new(64, 64, View::new(-5.0, -5.0, 105.0, 105.0));
     let (bytes, _) = write_svg(&doc, &opts, true).unwrap();
     let scene = read_svg(std::str::from_utf8(&bytes).unwrap()).unwrap();

@@ -205,14 +205,13 @@ pub struct RenderDescription {
 impl RenderDescription {
     /// The document described (at most three layers).
     pub fn document(&self) -> Document {
-        Document {
-            layers: self
-                .layers
+        Document::new(
+            self.layers
                 .iter()
                 .take(3)
                 .map(MeshDescription::build)
                 .collect(),
-        }
+        )
     }
 
     /// The options described, for `doc`.
