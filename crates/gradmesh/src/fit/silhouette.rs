@@ -68,23 +68,24 @@ impl Silhouette {
         (inside, ((x1 - x0) * (y1 - y0)) as u32)
     }
 
-    /// Whether leaf `cell` of `tree` is kept as a face: at least half its pixels are inside.
-    pub fn keeps(&self, tree: &Quadtree, cell: &Cell) -> bool {
+    /// The pixels of leaf `cell` of `tree` inside, the pixels in all, and whether the leaf is
+    /// kept as a face: at least half its pixels are inside.
+    fn coverage(&self, tree: &Quadtree, cell: &Cell) -> (u32, u32, bool) {
         let (a, b) = tree.cell_corners(cell);
         let (inside, all) = self.count(a, b);
-        all > 0 && 2 * inside >= all
+        (inside, all, all > 0 && 2 * inside >= all)
+    }
+
+    /// Whether leaf `cell` of `tree` is kept as a face ([`Silhouette::coverage`]).
+    pub fn keeps(&self, tree: &Quadtree, cell: &Cell) -> bool {
+        self.coverage(tree, cell).2
     }
 
     /// What leaf `cell` costs in pixels on the wrong side of the outline: those outside if it
     /// is kept, those inside if not, at [`MISCOVERED_PIXEL_ERROR`] each.
     pub fn miscovered_error(&self, tree: &Quadtree, cell: &Cell) -> f64 {
-        let (a, b) = tree.cell_corners(cell);
-        let (inside, all) = self.count(a, b);
-        let wrong = if all > 0 && 2 * inside >= all {
-            all - inside
-        } else {
-            inside
-        };
+        let (inside, all, kept) = self.coverage(tree, cell);
+        let wrong = if kept { all - inside } else { inside };
         wrong as f64 * MISCOVERED_PIXEL_ERROR
     }
 

@@ -1611,17 +1611,22 @@ mod tests {
         );
     }
 
-    /// A document's view is written after the version, read back as written, and refused
-    /// when it is empty or reversed.
-    #[test]
-    fn the_view_round_trips_and_bad_ones_are_refused() {
+    /// One grey sRGB quad over the unit square.
+    fn grey_unit_square() -> GradientMesh {
         let mut mesh = GradientMesh::new(ColourSpace::Srgb);
         for (x, y) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
             mesh.add_point(Point::new(x, y), [0.5; 3]);
         }
         mesh.add_face([0, 1, 2, 3]);
+        mesh
+    }
+
+    /// A document's view is written after the version, read back as written, and refused
+    /// when it is empty or reversed.
+    #[test]
+    fn the_view_round_trips_and_bad_ones_are_refused() {
         let doc = Document {
-            layers: vec![mesh],
+            layers: vec![grey_unit_square()],
             view: Some(kurbo::Rect::new(-2.0, 0.0, 3.5, 4.0)),
         };
         let text = write_document(&doc);
@@ -1636,11 +1641,7 @@ mod tests {
 
     #[test]
     fn wedge_opacity_rules() {
-        let mut mesh = GradientMesh::new(ColourSpace::Srgb);
-        for (x, y) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)] {
-            mesh.add_point(Point::new(x, y), [0.5; 3]);
-        }
-        mesh.add_face([0, 1, 2, 3]);
+        let mut mesh = grey_unit_square();
         let text_colour = "rgb(255 0 0 / 0.5)";
         let (c, _) = parse_css_colour(text_colour, ColourSpace::Srgb).unwrap();
         for opacity in [None, Some(0.5), Some(0.75)] {
