@@ -58,20 +58,22 @@ pub struct RenderOptions {
     /// that passes the colour tolerance with fewer cells than linear colour (default `true`).
     /// `false` draws every face with linear colour (more triangles), for comparison.
     pub quadratic: bool,
-    /// Plan the faces this render plans with looser tolerances ([`DRAFT_LOOSENING`] times the
-    /// colour and outline tolerances, twice the largest quad), for an editor while a gesture is
-    /// open. Through a [`RenderCache`](super::RenderCache) only the faces an edit reaches are
-    /// planned, so the rest of the picture keeps its exact plans, and the next render without
-    /// `draft` plans the drafted faces again at the full tolerances and builds the drafted
-    /// layers' triangles again: the picture after the gesture is the one a render from scratch
-    /// gives. Without a cache every face is drafted.
+    /// Draw quickly for an editor while a gesture is open. Through a
+    /// [`RenderCache`](super::RenderCache) that prepared the same faces before, the faces an
+    /// edit reaches keep the cells of that preparation (after its balancing) and are only
+    /// evaluated again on the moved points: nothing is measured or balanced, and every other
+    /// face keeps its plan and triangles. Otherwise (no cache, or a changed topology) the
+    /// faces are planned with looser tolerances ([`DRAFT_LOOSENING`] times the colour and
+    /// outline tolerances, twice the largest quad). The next render without `draft` plans the
+    /// drafted faces again at the full tolerances and builds the drafted layers' triangles
+    /// again: the picture after the gesture is the one a render from scratch gives.
     /// Only the fast path drafts (the uniform path and [`reference`](Self::reference) ignore it).
     pub draft: bool,
 }
 
 /// How many times looser than the options' colour and outline tolerances a
-/// [`draft`](RenderOptions::draft) plans faces (a colour error under one Delta E for the
-/// default tolerance).
+/// [`draft`](RenderOptions::draft) plans the faces it plans (a colour error under one Delta E
+/// for the default tolerance).
 pub const DRAFT_LOOSENING: f64 = 4.0;
 
 impl Default for RenderOptions {

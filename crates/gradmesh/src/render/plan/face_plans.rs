@@ -19,6 +19,8 @@ use crate::limit_surface::patches::{
 use crate::render::arrays::each4;
 use crate::view::ToPixels;
 
+mod frozen;
+
 /// Quadratic colour is tried on a face only while its linear error is at most this many times
 /// the tolerance: with larger errors the quarter points that check it can miss a steep colour
 /// edge (Glasses.off at 160 px fails the accuracy test at twice this value), and quadratic

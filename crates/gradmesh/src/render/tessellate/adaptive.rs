@@ -131,6 +131,9 @@ pub(crate) struct TessellationCache {
     /// The data of the base level the plans were made from.
     data: Vec<VertexData>,
     faces: Vec<CachedPlan>,
+    /// The plans after balancing (empty until a preparation kept them): a draft keeps their
+    /// counts and orders ([`FacePlanner::regrid_all`]).
+    balanced: Vec<CachedPlan>,
     /// Whether each face's plan was made by a draft ([`RenderOptions::draft`](crate::render::RenderOptions::draft)).
     drafted: Vec<bool>,
     /// What the plans drew (empty until the triangles of the plans above are built).
@@ -186,6 +189,22 @@ impl TessellationCache {
         self.topology_id = Some(topology_id);
         self.base_level = base_level;
         self.space = Some(space);
+        self.balanced.clear();
+    }
+
+    /// Keeps the plans a draft evaluated again at the balanced counts ([`FacePlanner::regrid_all`],
+    /// the faces `faces` did not reuse) as drafted, and the others' plans as they were planned,
+    /// so that the next render that is not a draft plans the drafted faces again and balances
+    /// the rest as a render from scratch would; `data` is the base level's data now.
+    fn keep_regridded_plans(&mut self, faces: &FacePlans, data: &[VertexData]) {
+        for (f, cached) in faces.to_cached().enumerate() {
+            if !faces.reused[f] {
+                self.faces[f] = cached;
+                self.drafted[f] = true;
+            }
+        }
+        self.data.clear();
+        self.data.extend_from_slice(data);
     }
 }
 
@@ -301,7 +320,15 @@ pub(crate) fn tessellate(
             plans: &c.faces,
             again,
         });
-    let mut faces = planner.plan_all(earlier)?;
+    // A draft through a cache keeps the last balanced counts and orders.
+    let regridded = (fitting_cache.zip(again.as_deref()))
+        .filter(|(c, _)| th.draft && c.balanced.len() == nf)
+        .and_then(|(c, again)| planner.regrid_all(&c.balanced, again));
+    let is_regridded = regridded.is_some();
+    let mut faces = match regridded {
+        Some(faces) => faces,
+        None => planner.plan_all(earlier)?,
+    };
     // Cached as planned: balancing below copies a plan it changes. What the last plans drew
     // is taken out (it fits these plans only where they were kept).
     let mut last_triangles = None;
@@ -309,11 +336,17 @@ pub(crate) fn tessellate(
         // After a draft, every face builds its triangles again.
         let after_draft = !th.draft && cache.has_drafts();
         last_triangles = (cache.triangles.take()).filter(|_| again.is_some() && !after_draft);
-        cache.keep_plans(&faces, topology_id, k0, th.space, d, th.draft);
+        if is_regridded {
+            cache.keep_regridded_plans(&faces, d);
+        } else {
+            cache.keep_plans(&faces, topology_id, k0, th.space, d, th.draft);
+        }
     }
 
     // 2. Counts per edge, and the samples faces share.
-    planner.balance(&mut faces)?;
+    if !is_regridded {
+        planner.balance(&mut faces)?;
+    }
     let bounds = colour_bounds(&faces.plans, d);
     let stitching = Stitching::new(&planner, t, &faces, xf, size, bounds.as_ref())?;
 
@@ -331,6 +364,8 @@ pub(crate) fn tessellate(
         });
     let (triangle_blocks, face_starts) = build_blocks(&stitching, nf, last_blocks);
     if let (Some(cache), Some(counts)) = (cache, counts) {
+        cache.balanced.clear();
+        cache.balanced.extend(faces.to_cached());
         cache.triangles = Some(TriangleBlocks {
             counts,
             bounds,
