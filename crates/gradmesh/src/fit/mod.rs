@@ -977,64 +977,102 @@ const COARSE_ROUNDING_DB: f64 = 32.0;
 /// binary).
 const POSITION_STEP: f64 = 0.5;
 
-/// `p` rounded to a tenth of a pixel, and to [`POSITION_STEP`] if `coarse` (else the same).
-fn rounded_positions(p: kurbo::Point, coarse: bool) -> (kurbo::Point, kurbo::Point) {
-    let fine = kurbo::Point::new(round_to_decimals(p.x, 1), round_to_decimals(p.y, 1));
-    let step = |v: f64| (v / POSITION_STEP).round() * POSITION_STEP + 0.0;
-    let stepped = kurbo::Point::new(step(p.x), step(p.y));
-    (fine, if coarse { stepped } else { fine })
+/// How finely an output position is written, coarsest first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Precision {
+    /// To [`POSITION_STEP`].
+    Step,
+    /// To a tenth of a pixel.
+    Tenth,
+    /// As fitted.
+    Exact,
+}
+
+impl Precision {
+    fn finer(self) -> Precision {
+        match self {
+            Precision::Step => Precision::Tenth,
+            Precision::Tenth | Precision::Exact => Precision::Exact,
+        }
+    }
+
+    fn round(self, p: kurbo::Point) -> kurbo::Point {
+        let step = |v: f64| (v / POSITION_STEP).round() * POSITION_STEP + 0.0;
+        match self {
+            Precision::Step => kurbo::Point::new(step(p.x), step(p.y)),
+            Precision::Tenth => {
+                kurbo::Point::new(round_to_decimals(p.x, 1), round_to_decimals(p.y, 1))
+            }
+            Precision::Exact => p,
+        }
+    }
 }
 
 /// Rounds the positions and colours of `mesh` for output, what
 /// [`VectoriseOptions::round_output`] asks for: if `coarse`, positions to [`POSITION_STEP`]
 /// and colours to [`colour_decimals`], else both to tenths. Points whose rounded positions
-/// meet, and the points of faces that rounding folds, keep their positions to a tenth of a
-/// pixel (all of them if folds remain).
+/// meet, and the points of faces that rounding folds, are written finer (to a tenth of a
+/// pixel, then as fitted) until none meet and no fold remains that the fitted positions lack.
 fn round_for_output(mesh: &mut GradientMesh, coarse: bool) -> Result<(), Error> {
     let decimals = colour_decimals(mesh.colour_space, coarse);
-    let rounded: Vec<_> = mesh
-        .points
-        .iter()
-        .map(|p| rounded_positions(p.position, coarse))
-        .collect();
-    let mut uses: HashMap<(u64, u64), usize> = HashMap::new();
-    for (_, coarse) in &rounded {
-        *uses
-            .entry((coarse.x.to_bits(), coarse.y.to_bits()))
-            .or_default() += 1;
-    }
-    for (p, &(fine, coarse)) in mesh.points.iter_mut().zip(&rounded) {
-        let alone = uses[&(coarse.x.to_bits(), coarse.y.to_bits())] == 1;
-        p.position = if alone { coarse } else { fine };
+    for p in &mut mesh.points {
         p.colour = p.colour.map(|c| round_to_decimals(c, decimals));
     }
-    if coarse {
-        keep_fine_where_folded(mesh, &rounded)?;
-    }
-    Ok(())
-}
-
-/// Puts the points of the faces folded by rounding back at their `rounded` tenths of a pixel
-/// (every point if folds remain).
-fn keep_fine_where_folded(
-    mesh: &mut GradientMesh,
-    rounded: &[(kurbo::Point, kurbo::Point)],
-) -> Result<(), Error> {
-    let folds = find_folds(mesh)?;
-    let folded: Vec<u32> = folds
-        .iter()
-        .flat_map(|f| &f.faces)
-        .flat_map(|&f| mesh.faces[f].clone())
-        .collect();
-    for v in folded {
-        mesh.points[v as usize].position = rounded[v as usize].0;
-    }
-    if !folds.is_empty() && !find_folds(mesh)?.is_empty() {
-        for (p, &(fine, _)) in mesh.points.iter_mut().zip(rounded) {
-            p.position = fine;
+    let fitted: Vec<kurbo::Point> = mesh.points.iter().map(|p| p.position).collect();
+    let start = if coarse {
+        Precision::Step
+    } else {
+        Precision::Tenth
+    };
+    let mut precision = vec![start; fitted.len()];
+    loop {
+        place_rounded(mesh, &fitted, &mut precision);
+        let mut folded = vec![false; fitted.len()];
+        for fold in find_folds(mesh)? {
+            for &f in &fold.faces {
+                for &v in &mesh.faces[f] {
+                    folded[v as usize] = true;
+                }
+            }
+        }
+        if !refine_where(&mut precision, &folded) {
+            return Ok(());
         }
     }
-    Ok(())
+}
+
+/// Makes the precision of the points marked in `which` finer; returns whether one could be.
+fn refine_where(precision: &mut [Precision], which: &[bool]) -> bool {
+    let mut refined = false;
+    for (q, _) in precision.iter_mut().zip(which).filter(|(_, &w)| w) {
+        refined |= *q != Precision::Exact;
+        *q = q.finer();
+    }
+    refined
+}
+
+/// Puts the points of `mesh` at their `fitted` positions rounded to their `precision`, made
+/// finer where two would meet.
+fn place_rounded(mesh: &mut GradientMesh, fitted: &[kurbo::Point], precision: &mut [Precision]) {
+    let key = |p: kurbo::Point| ((p.x + 0.0).to_bits(), (p.y + 0.0).to_bits());
+    loop {
+        let at: Vec<kurbo::Point> = fitted
+            .iter()
+            .zip(precision.iter())
+            .map(|(&p, q)| q.round(p))
+            .collect();
+        let mut uses: HashMap<(u64, u64), usize> = HashMap::new();
+        for &p in &at {
+            *uses.entry(key(p)).or_default() += 1;
+        }
+        let meet: Vec<bool> = at.iter().map(|&p| uses[&key(p)] > 1).collect();
+        if !refine_where(precision, &meet) {
+            for (point, p) in mesh.points.iter_mut().zip(at) {
+                point.position = p;
+            }
+            return;
+        }
+    }
 }
 
 /// The document of `mesh`, rendered at the picture's size to measure its PSNR. A mesh of a
@@ -1117,6 +1155,69 @@ mod tests {
         );
         assert_eq!(mesh.points[0].colour, [50.0, -4.0, 13.0]);
         assert_eq!(mesh.points[5].colour, [50.0, 0.0, -8.0]);
+    }
+
+    /// A 2 x 2 grid of squares of side `cell` whose middle point is moved to `(x, x)`: towards
+    /// the first corner, past the diagonal of the first square, which then folds.
+    fn grid_moved(cell: f64, x: f64) -> GradientMesh {
+        let mut mesh = GradientMesh::new(ColourSpace::Lab);
+        for j in 0..3 {
+            for i in 0..3 {
+                let p = kurbo::Point::new(cell * i as f64, cell * j as f64);
+                let p = if (i, j) == (1, 1) {
+                    kurbo::Point::new(x, x)
+                } else {
+                    p
+                };
+                mesh.add_point(p, [50.0, 0.0, 0.0]);
+            }
+        }
+        for a in [0, 1, 3, 4] {
+            mesh.add_face(vec![a, a + 1, a + 4, a + 3]);
+        }
+        mesh
+    }
+
+    /// Where between `cell` and a fifth of it the middle point of [`grid_moved`] starts to fold
+    /// the surface: the last fold-free position found by bisection.
+    fn fold_threshold(cell: f64) -> f64 {
+        let folds = |x: f64| !find_folds(&grid_moved(cell, x)).unwrap().is_empty();
+        let (mut free, mut folded) = (cell, 0.2 * cell);
+        assert!(!folds(free) && folds(folded));
+        for _ in 0..50 {
+            let mid = 0.5 * (free + folded);
+            if folds(mid) {
+                folded = mid;
+            } else {
+                free = mid;
+            }
+        }
+        free
+    }
+
+    /// Output rounding folds nothing the fitted positions do not: a point just short of
+    /// folding the surface, where its tenths of a pixel fold it, keeps its fitted position.
+    #[test]
+    fn rounding_folds_nothing() {
+        // A cell size whose fold threshold rounds (to tenths) down, into the fold.
+        let (cell, x) = (6..40)
+            .map(|k| 0.5 * k as f64)
+            .map(|cell| (cell, fold_threshold(cell)))
+            .find(|&(_, x)| round_to_decimals(x, 1) < x)
+            .expect("a threshold that rounds down");
+        let tenths = grid_moved(cell, round_to_decimals(x, 1));
+        assert!(!find_folds(&tenths).unwrap().is_empty(), "{cell} px: {x}");
+        let mut mesh = grid_moved(cell, x);
+        round_for_output(&mut mesh, false).unwrap();
+        assert!(find_folds(&mesh).unwrap().is_empty(), "{cell} px: {x}");
+        assert_eq!(mesh.points[4].position, kurbo::Point::new(x, x));
+        assert_eq!(
+            mesh.points[8].position,
+            kurbo::Point::new(2.0 * cell, 2.0 * cell)
+        );
+        let mut mesh = grid_moved(cell, x);
+        round_for_output(&mut mesh, true).unwrap();
+        assert!(find_folds(&mesh).unwrap().is_empty(), "{cell} px: {x}");
     }
 
     /// Meshes below 1024 points get more rounds of position steps, up to three times as many.

@@ -341,9 +341,9 @@ fn numbers_after(text: &str, key: &str) -> Vec<f64> {
         .collect()
 }
 
-/// `picture` vectorised with 150 points, rounded and not: the rounded document renders within
-/// 0.1 dB of the unrounded one, its file is under three quarters of the size; returns its
-/// positions and colours as written.
+/// `picture` vectorised with 150 points, rounded and not: neither folds, the rounded document
+/// renders within 0.1 dB of the unrounded one, its file is under three quarters of the size;
+/// returns its positions and colours as written.
 fn rounded_against_unrounded(picture: &RgbaImage) -> (Vec<f64>, Vec<f64>) {
     let run = |round_output: bool| {
         let options = VectoriseOptions {
@@ -368,6 +368,9 @@ fn rounded_against_unrounded(picture: &RgbaImage) -> (Vec<f64>, Vec<f64>) {
         text.len(),
         exact_text.len()
     );
+    let exact_folds = gradmesh::render::find_folds(&exact.document.layers[0]).unwrap();
+    let folds = gradmesh::render::find_folds(&rounded.document.layers[0]).unwrap();
+    assert!(exact_folds.is_empty() && folds.is_empty(), "{folds:?}");
     let (w, h) = (picture.width, picture.height);
     let back = render(&rounded.document, w, h);
     assert!((psnr(picture, &back).unwrap() - rounded.psnr).abs() < 0.5);
@@ -410,16 +413,18 @@ fn grainy_picture(w: u32, h: u32) -> RgbaImage {
 }
 
 /// A fit below 32 dB is written with whole Lab units and half pixels (a tenth where half
-/// pixels would make points meet or faces fold), within 0.1 dB of the unrounded render.
+/// pixels would make points meet or faces fold, the fitted position where a tenth would),
+/// within 0.1 dB of the unrounded render.
 #[test]
 fn rounded_output_of_a_photograph_like_fit_is_coarse() {
     let picture = grainy_picture(120, 80);
     let (positions, colours) = rounded_against_unrounded(&picture);
     assert!(colours.iter().all(|c| c.fract() == 0.0), "{colours:?}");
-    assert!(positions.iter().all(|&v| multiple(v, 0.1)), "{positions:?}");
+    let tenths = positions.iter().filter(|&&v| multiple(v, 0.1)).count();
+    assert!(tenths * 50 >= positions.len() * 49, "{positions:?}");
     let halves = positions.iter().filter(|&&v| multiple(v, 0.5)).count();
     assert!(
-        halves * 10 >= positions.len() * 9,
+        halves * 20 >= positions.len() * 17,
         "{halves} of {}",
         positions.len()
     );
