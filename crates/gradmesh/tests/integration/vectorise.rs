@@ -305,6 +305,57 @@ fn moving_points_follows_an_edge() {
     assert!(back.pixels.iter().all(|p| p[3] > 0.99));
 }
 
+/// Discs of three colours and a slanted edge on a background: edges that need cells down to
+/// the smallest size to follow.
+fn discs_and_edge(w: u32, h: u32) -> RgbaImage {
+    let discs = [
+        (30.0, 28.0, 17.0, [0.9, 0.2, 0.2]),
+        (70.0, 60.0, 21.0, [0.2, 0.7, 0.3]),
+        (24.0, 74.0, 11.0, [0.95, 0.9, 0.2]),
+    ];
+    let pixels = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
+            let inside = discs
+                .iter()
+                .find(|(cx, cy, r, _)| (x - cx).hypot(y - cy) < *r);
+            let [r, g, b] = match inside {
+                Some(&(.., colour)) => colour,
+                None if x - 0.4 * y > 0.55 * w as f64 => [0.1, 0.15, 0.5],
+                None => [0.8, 0.8, 0.75],
+            };
+            [r, g, b, 1.0]
+        })
+        .collect();
+    RgbaImage {
+        width: w,
+        height: h,
+        pixels,
+    }
+}
+
+/// A larger budget fits at least as well: a starting grid whose cells cannot halve down to
+/// the 3 px floor (10.7 px cells stop at 5.3 px) would fit these edges worse with 400 points
+/// than with 320.
+#[test]
+fn a_larger_budget_fits_edges_no_worse() {
+    let image = discs_and_edge(96, 96);
+    let fit = |points: usize| {
+        let options = VectoriseOptions {
+            points: Some(points),
+            fit_positions: false,
+            round_output: false,
+            ..VectoriseOptions::default()
+        };
+        vectorise(&image, &options).unwrap().psnr
+    };
+    let (smaller, larger) = (fit(320), fit(400));
+    assert!(
+        larger >= smaller - 0.05,
+        "400 points {larger:.2} dB, 320 points {smaller:.2} dB"
+    );
+}
+
 /// A picture with smooth shading and a soft slanted edge, as photographs have.
 fn shaded_picture(w: u32, h: u32) -> RgbaImage {
     let pixels = (0..w * h)
