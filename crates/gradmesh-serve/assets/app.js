@@ -234,7 +234,9 @@ function setView(x0, y0, width) {
 
 function fitView() {
   let [minX, minY, maxX, maxY] = [Infinity, Infinity, -Infinity, -Infinity];
-  for (const layer of editor.state ? editor.state.layers : []) {
+  // The document's own view (a vectorised picture's rectangle) when it has one, else its points.
+  if (editor.state && editor.state.view) [minX, minY, maxX, maxY] = editor.state.view;
+  else for (const layer of editor.state ? editor.state.layers : []) {
     for (const [x, y] of layer.points) {
       minX = Math.min(minX, x); minY = Math.min(minY, y);
       maxX = Math.max(maxX, x); maxY = Math.max(maxY, y);

@@ -79,6 +79,8 @@ impl Status<'_> {
             "can_undo": self.can_undo,
             "can_redo": self.can_redo,
             "folds_checked": self.folds.is_some(),
+            // The rectangle the document says it shows (a vectorised picture's), or null.
+            "view": self.picture.doc.view.map(|r| [r.x0, r.y0, r.x1, r.y1]),
             "layers": layers,
         })
     }
@@ -191,5 +193,26 @@ mod tests {
             .unwrap()
             .0;
         assert_eq!(srgb_hex(ColourSpace::Lab, red), "#ff0000");
+    }
+
+    /// The state carries the document's own view, which the page's first view fits, or null.
+    #[test]
+    fn the_state_carries_the_documents_view() {
+        let mut doc = gradmesh::Document::new(vec![GradientMesh::new(ColourSpace::Lab)]);
+        let state = |doc: &gradmesh::Document| {
+            let picture = Picture::new(doc.clone());
+            let status = Status {
+                picture: &picture,
+                file: None,
+                modified: false,
+                can_undo: false,
+                can_redo: false,
+                folds: None,
+            };
+            status.to_json()
+        };
+        assert_eq!(state(&doc)["view"], Value::Null);
+        doc.view = Some(kurbo::Rect::new(-50.0, -20.0, 250.0, 130.0));
+        assert_eq!(state(&doc)["view"], json!([-50.0, -20.0, 250.0, 130.0]));
     }
 }

@@ -1,7 +1,8 @@
 //! The editor's files in a real browser (headless Chromium through chromedriver, real pointer
 //! and keyboard events): the save state and the question before a file is replaced, the
 //! recovery copy restored from the page, the six layers of the Tucan opened as layers with
-//! picking across layers, the preview, import as layer, and the PDF export from the page.
+//! picking across layers, the preview, import as layer, the PDF export from the page, and a
+//! document's own view as the first view.
 //! Fails (never skips) when Chromium, chromedriver or the shared data is missing.
 //!
 //! Screenshots go to `target/editor-screenshots/`; with `GRADMESH_UPDATE_SCREENSHOTS=1` also
@@ -414,6 +415,50 @@ async fn open_downloading_browser(dir: &Path) -> (Driver, Client) {
             Err(e) => panic!("a Chromium session through chromedriver: {e}"),
         }
     }
+}
+
+/// A document with a view of its own (a vectorised picture's rectangle) opens showing that
+/// rectangle, not the bounds of its points.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_document_opens_on_its_own_view() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("framed.json");
+    let framed = SQUARE.replacen(
+        r#""version":1,"#,
+        r#""version":1,"view":[-100,-50,300,150],"#,
+        1,
+    );
+    std::fs::write(&file, framed).unwrap();
+    let running = serve(&file, Vec::new()).await;
+    in_browser!(client, open_browser().await, {
+        own_view(&client, &running).await
+    });
+}
+
+async fn own_view(client: &Client, running: &Running) -> Result<(), String> {
+    goto(client, running).await?;
+    let v = js(
+        client,
+        "const v = window.gradmesh.view; return [v.x0, v.y0, v.x1, v.y1];",
+    )
+    .await;
+    let v: Vec<f64> = (0..4).map(|k| v[k].as_f64().unwrap()).collect();
+    // The points span 0..100 both ways (centre (50, 50)); the document's view -100..300 x
+    // -50..150 (centre (100, 50)).
+    let centre = [(v[0] + v[2]) / 2.0, (v[1] + v[3]) / 2.0];
+    assert!(
+        (centre[0] - 100.0).abs() < 1e-6 && (centre[1] - 50.0).abs() < 1e-6,
+        "the first view {v:?} is not centred on the document's view"
+    );
+    assert!(
+        v[0] <= -100.0 && v[1] <= -50.0 && v[2] >= 300.0 && v[3] >= 150.0,
+        "the first view {v:?} does not hold the document's view"
+    );
+    assert!(
+        v[2] - v[0] < 1.5 * 400.0,
+        "the first view {v:?} is far wider"
+    );
+    Ok(())
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
