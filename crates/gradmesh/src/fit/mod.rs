@@ -1027,7 +1027,8 @@ impl Precision {
 /// [`VectoriseOptions::round_output`] asks for: if `coarse`, positions to [`POSITION_STEP`]
 /// and colours to [`colour_decimals`], else both to tenths. Points whose rounded positions
 /// meet, and the points of faces that rounding folds, are written finer (to a tenth of a
-/// pixel, then as fitted) until none meet and no fold remains that the fitted positions lack.
+/// pixel, then as fitted; then the points of the faces around them) until none meet and no
+/// fold remains that the fitted positions lack.
 fn round_for_output(mesh: &mut GradientMesh, coarse: bool) -> Result<(), Error> {
     let decimals = colour_decimals(mesh.colour_space, coarse);
     for p in &mut mesh.points {
@@ -1042,18 +1043,28 @@ fn round_for_output(mesh: &mut GradientMesh, coarse: bool) -> Result<(), Error> 
     let mut precision = vec![start; fitted.len()];
     loop {
         place_rounded(mesh, &fitted, &mut precision);
-        let mut folded = vec![false; fitted.len()];
-        for fold in find_folds(mesh)? {
-            for &f in &fold.faces {
-                for &v in &mesh.faces[f] {
-                    folded[v as usize] = true;
-                }
-            }
+        let folds = find_folds(mesh)?;
+        let folded = points_of_faces(mesh, |f| folds.iter().any(|x| x.faces.contains(&f)));
+        if refine_where(&mut precision, &folded) {
+            continue;
         }
-        if !refine_where(&mut precision, &folded) {
+        // The folded faces' points are as fitted: the rounding of their neighbours folds them.
+        let around = points_of_faces(mesh, |f| mesh.faces[f].iter().any(|&v| folded[v as usize]));
+        if !refine_where(&mut precision, &around) {
             return Ok(());
         }
     }
+}
+
+/// Per point of `mesh`, whether a face for which `chosen` holds has it.
+fn points_of_faces(mesh: &GradientMesh, chosen: impl Fn(usize) -> bool) -> Vec<bool> {
+    let mut marked = vec![false; mesh.points.len()];
+    for (_, face) in mesh.faces.iter().enumerate().filter(|&(f, _)| chosen(f)) {
+        for &v in face {
+            marked[v as usize] = true;
+        }
+    }
+    marked
 }
 
 /// Makes the precision of the points marked in `which` finer; returns whether one could be.
