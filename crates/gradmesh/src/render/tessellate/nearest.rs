@@ -33,10 +33,14 @@ pub(crate) struct NearestSegments {
 }
 
 impl NearestSegments {
-    /// The boxes (`[[x0, x1], [y0, y1]]`, pixels) of the segments of `old` and of this that lie
-    /// in neither their common start nor their common end (equal in every bit). The others keep
-    /// their order, and an answer (the least distance, then the least index, whatever the grid)
-    /// changes only where a segment of the changed middle is as near.
+    /// The boxes (`[[x0, x1], [y0, y1]]`, pixels) of the segments of `old` and of this that
+    /// differ (in some bit), outside which no answer changes. With as many segments in both,
+    /// the segments that differ at the same index: every other segment keeps its index, and an
+    /// answer (the least distance, then the least index, whatever the grid) changes only where
+    /// a differing segment, old or new, is as near. Otherwise those that lie in neither their
+    /// common start nor their common end: the others keep their order in the same way. (A
+    /// common start and end alone would take in the whole outline when an edit moves its
+    /// first and last segments, as a point where an outline loop begins does.)
     pub fn changed_boxes(&self, old: &NearestSegments) -> Vec<[[f64; 2]; 2]> {
         let bits = |s: &Segment| {
             (
@@ -46,13 +50,19 @@ impl NearestSegments {
         };
         let (new, old) = (&self.segments, &old.segments);
         let same = |(a, b): (&Segment, &Segment)| bits(a) == bits(b);
+        let span = |s: &Segment| [0, 1].map(|k| [s.a[k].min(s.b[k]), s.a[k].max(s.b[k])]);
+        if new.len() == old.len() {
+            return (new.iter().zip(old))
+                .filter(|&p| !same(p))
+                .flat_map(|(a, b)| [span(a), span(b)])
+                .collect();
+        }
         let prefix = new.iter().zip(old).take_while(|&p| same(p)).count();
         let rest = new.len().min(old.len()) - prefix;
         let suffix = (new.iter().rev().zip(old.iter().rev()))
             .take(rest)
             .take_while(|&p| same(p))
             .count();
-        let span = |s: &Segment| [0, 1].map(|k| [s.a[k].min(s.b[k]), s.a[k].max(s.b[k])]);
         (new[prefix..new.len() - suffix].iter())
             .chain(&old[prefix..old.len() - suffix])
             .map(span)
@@ -287,6 +297,40 @@ mod tests {
             }
         }
         assert!(checked > 30_000);
+    }
+
+    /// With as many segments as before, only those that differ count as changed, also when
+    /// they are the first and the last (an outline loop beginning at a moved point); with a
+    /// different number, everything between the common start and end.
+    #[test]
+    fn changed_boxes_are_those_of_the_segments_that_differ() {
+        let segs: Vec<Segment> = (0..50)
+            .map(|k| Segment {
+                a: [k as f64, 0.0],
+                b: [k as f64 + 1.0, 0.0],
+                ca: [0.5; 4],
+                cb: [0.5; 4],
+                bump: [0.0; 4],
+            })
+            .collect();
+        let old = NearestSegments::new(segs.clone());
+        let mut moved = segs.clone();
+        moved[0].a[1] = 2.0;
+        moved[49].b[1] = -3.0;
+        let boxes = NearestSegments::new(moved.clone()).changed_boxes(&old);
+        assert_eq!(
+            boxes,
+            vec![
+                [[0.0, 1.0], [0.0, 2.0]],
+                [[0.0, 1.0], [0.0, 0.0]],
+                [[49.0, 50.0], [-3.0, 0.0]],
+                [[49.0, 50.0], [0.0, 0.0]],
+            ]
+        );
+        moved.pop();
+        let fewer = NearestSegments::new(moved).changed_boxes(&old);
+        assert_eq!(fewer.len(), 49 + 50);
+        assert!(NearestSegments::new(segs).changed_boxes(&old).is_empty());
     }
 
     #[test]
