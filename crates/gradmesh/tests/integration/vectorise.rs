@@ -236,23 +236,27 @@ fn bad_options_are_refused() {
     assert!(vectorise(&empty, &VectoriseOptions::default()).is_err());
 }
 
-/// A picture of two colours split by a slanted line that no cell side follows.
-fn slanted_edge(w: u32, h: u32) -> RgbaImage {
+/// A `w` x `h` picture whose pixel at centre `(x, y)` is `colour_at(x, y)`.
+fn picture(w: u32, h: u32, colour_at: impl Fn(f64, f64) -> [f32; 4]) -> RgbaImage {
     let pixels = (0..w * h)
-        .map(|i| {
-            let (x, y) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
-            if x + 0.3 * y < 0.45 * w as f64 {
-                [0.85, 0.55, 0.2, 1.0]
-            } else {
-                [0.15, 0.25, 0.6, 1.0]
-            }
-        })
+        .map(|i| colour_at((i % w) as f64 + 0.5, (i / w) as f64 + 0.5))
         .collect();
     RgbaImage {
         width: w,
         height: h,
         pixels,
     }
+}
+
+/// A picture of two colours split by a slanted line that no cell side follows.
+fn slanted_edge(w: u32, h: u32) -> RgbaImage {
+    picture(w, h, |x, y| {
+        if x + 0.3 * y < 0.45 * w as f64 {
+            [0.85, 0.55, 0.2, 1.0]
+        } else {
+            [0.15, 0.25, 0.6, 1.0]
+        }
+    })
 }
 
 /// Moving the points cuts the error where the picture has an edge between cell corners; the
@@ -313,25 +317,17 @@ fn discs_and_edge(w: u32, h: u32) -> RgbaImage {
         (70.0, 60.0, 21.0, [0.2, 0.7, 0.3]),
         (24.0, 74.0, 11.0, [0.95, 0.9, 0.2]),
     ];
-    let pixels = (0..w * h)
-        .map(|i| {
-            let (x, y) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
-            let inside = discs
-                .iter()
-                .find(|(cx, cy, r, _)| (x - cx).hypot(y - cy) < *r);
-            let [r, g, b] = match inside {
-                Some(&(.., colour)) => colour,
-                None if x - 0.4 * y > 0.55 * w as f64 => [0.1, 0.15, 0.5],
-                None => [0.8, 0.8, 0.75],
-            };
-            [r, g, b, 1.0]
-        })
-        .collect();
-    RgbaImage {
-        width: w,
-        height: h,
-        pixels,
-    }
+    picture(w, h, |x, y| {
+        let inside = discs
+            .iter()
+            .find(|(cx, cy, r, _)| (x - cx).hypot(y - cy) < *r);
+        let [r, g, b] = match inside {
+            Some(&(.., colour)) => colour,
+            None if x - 0.4 * y > 0.55 * w as f64 => [0.1, 0.15, 0.5],
+            None => [0.8, 0.8, 0.75],
+        };
+        [r, g, b, 1.0]
+    })
 }
 
 /// A larger budget fits at least as well: a starting grid whose cells cannot halve down to
@@ -358,25 +354,18 @@ fn a_larger_budget_fits_edges_no_worse() {
 
 /// A picture with smooth shading and a soft slanted edge, as photographs have.
 fn shaded_picture(w: u32, h: u32) -> RgbaImage {
-    let pixels = (0..w * h)
-        .map(|i| {
-            let (x, y) = ((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
-            let (u, v) = (x / w as f32, y / h as f32);
-            let edge = 1.0 / (1.0 + (-(x - 0.6 * y - 0.3 * w as f32) / 2.0).exp());
-            let wave = 0.5 + 0.5 * (6.0 * u + 3.0 * v).sin();
-            [
-                0.2 + 0.6 * edge * u + 0.1 * wave,
-                0.3 + 0.4 * v * (1.0 - edge) + 0.2 * wave,
-                0.7 - 0.5 * edge + 0.1 * u,
-                1.0,
-            ]
-        })
-        .collect();
-    RgbaImage {
-        width: w,
-        height: h,
-        pixels,
-    }
+    picture(w, h, |x, y| {
+        let (x, y) = (x as f32, y as f32);
+        let (u, v) = (x / w as f32, y / h as f32);
+        let edge = 1.0 / (1.0 + (-(x - 0.6 * y - 0.3 * w as f32) / 2.0).exp());
+        let wave = 0.5 + 0.5 * (6.0 * u + 3.0 * v).sin();
+        [
+            0.2 + 0.6 * edge * u + 0.1 * wave,
+            0.3 + 0.4 * v * (1.0 - edge) + 0.2 * wave,
+            0.7 - 0.5 * edge + 0.1 * u,
+            1.0,
+        ]
+    })
 }
 
 /// Every number in `text` in the lists after `key` (`"position": [..]`).
